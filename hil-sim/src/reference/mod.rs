@@ -1,0 +1,76 @@
+//! f64 continuous-time right-hand sides of the ODE models, written from the papers
+//! independently of model-core's discretisations. The accuracy check
+//! (`hil-sim accuracy`) integrates them with a fine adaptive step and compares the f32
+//! one-step-per-sample core against them.
+
+pub mod bouc_wen;
+pub mod bouc_wen_asym;
+pub mod dahl;
+pub mod lugre;
+pub mod spencer;
+
+/// The input at one instant: value, first and second time derivatives, command.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Input {
+    pub x: f64,
+    pub dx: f64,
+    pub ddx: f64,
+    pub u: f64,
+}
+
+/// An ODE model in continuous time, `ṡ = f(s, input)`, `y = g(s, input)`.
+pub trait Reference: Send + Sync {
+    /// Number of continuous states.
+    fn dim(&self) -> usize;
+    /// State at the first instant (must match what the f32 core starts from).
+    fn init(&self, first: &Input) -> Vec<f64>;
+    /// Time derivative of the state.
+    fn rhs(&self, s: &[f64], input: &Input, ds: &mut [f64]);
+    /// Model output (torque or force).
+    fn output(&self, s: &[f64], input: &Input) -> f64;
+}
+
+/// How the unit excitation (range about −1…1) is mapped to the model input.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InputScale {
+    pub amplitude: f64,
+    pub offset: f64,
+}
+
+/// The auxiliary command during a synthetic excitation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Command {
+    /// `u = 0` (model ignores it or uses its constant parameters).
+    None,
+    /// A constant command (A or V).
+    Constant(f64),
+}
+
+/// One model + one published parameter set to check.
+pub struct Case {
+    /// Model identifier (as in model-core's registry).
+    pub model: &'static str,
+    /// Which parameter set, with its source (e.g. "seed 000 Table 3 average").
+    pub label: String,
+    /// Flat parameter vector in the model's `PARAM_NAMES` order.
+    pub params: Vec<f32>,
+    /// The independent f64 reference built from the same parameters.
+    pub reference: Box<dyn Reference>,
+    /// Mapping of the unit synthetic excitations onto the input.
+    pub scale: InputScale,
+    pub command: Command,
+    /// Also check on the real displacement `D` (cm) and command `Y` (V) of
+    /// `shared/data/dyke/ranran_50.csv` (damper models with parameters in cm and N).
+    pub on_dyke_recording: bool,
+}
+
+/// Every case of every ODE model.
+pub fn cases() -> Vec<Case> {
+    let mut all = Vec::new();
+    all.extend(bouc_wen::cases());
+    all.extend(lugre::cases());
+    all.extend(spencer::cases());
+    all.extend(dahl::cases());
+    all.extend(bouc_wen_asym::cases());
+    all
+}
