@@ -1,4 +1,12 @@
 //! Host side of the MR clutch controller: recordings, replay through model-core,
 //! accuracy checks of the fixed-step core.
 
+pub mod accuracy;
+pub mod data;
+pub mod dispatch;
+pub mod excitation;
+pub mod metrics;
+pub mod params_file;
+pub mod recording;
 pub mod reference;
+pub mod replay;

@@ -67,3 +67,5 @@ pub fn count(values: &[f32], expected: usize) -> Result<(), ParamError> {
         Err(ParamError::WrongCount { expected, got: values.len() })
     }
 }
+
+impl core::error::Error for ParamError {}

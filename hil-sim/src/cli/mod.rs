@@ -1,0 +1,128 @@
+//! Command-line surface (shared/spec/cli-contract.md). Every subcommand takes `--json`:
+//! then stdout carries exactly one JSON object; progress and logs go to stderr.
+
+mod accuracy;
+mod demo;
+mod models;
+mod replay;
+
+use std::path::PathBuf;
+
+use anyhow::{bail, Context};
+use clap::{Args, Parser, Subcommand};
+use hil_sim::dispatch::RateChoice;
+use hil_sim::replay::Channels;
+
+#[derive(Parser, Debug)]
+#[command(name = "hil-sim", version, about = "Host tooling for the MR clutch torque controller")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub cmd: Cmd,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Cmd {
+    /// List every model with its parameters and state size.
+    Models(models::ModelsArgs),
+    /// Run a recording through the no_std core in f32, one step per sample.
+    Replay(replay::ReplayArgs),
+    /// Check the f32 fixed-step core against f64 adaptive-step references.
+    Accuracy(accuracy::AccuracyArgs),
+    /// The main job on the bundled data (see README).
+    Demo(demo::DemoArgs),
+}
+
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.cmd {
+        Cmd::Models(a) => models::run(a),
+        Cmd::Replay(a) => replay::run(a),
+        Cmd::Accuracy(a) => accuracy::run(a),
+        Cmd::Demo(a) => demo::run(a),
+    }
+}
+
+/// Channel mapping flags shared by the subcommands that read recordings.
+#[derive(Args, Debug, Clone)]
+pub struct ChannelArgs {
+    /// Time column (seconds).
+    #[arg(long, default_value = "t")]
+    pub time: String,
+    /// Model input column (Hall flux density for a clutch; `D` for the damper files).
+    #[arg(long, default_value = "b")]
+    pub input: String,
+    /// Measured output column (torque for a clutch; `F` for the damper files).
+    #[arg(long, default_value = "torque")]
+    pub output: String,
+    /// Channel driving current/voltage-dependent parameters (`Y` for the damper files).
+    #[arg(long)]
+    pub command: Option<String>,
+    /// Rate estimator: `backward`, `filtered:FC_HZ` or `kalman[:Q:R]` (seed 002).
+    #[arg(long, default_value = "backward")]
+    pub rate: String,
+}
+
+impl ChannelArgs {
+    pub fn channels(&self) -> Channels {
+        Channels {
+            time: self.time.clone(),
+            input: self.input.clone(),
+            output: self.output.clone(),
+            command: self.command.clone(),
+        }
+    }
+    pub fn rate(&self) -> anyhow::Result<RateChoice> {
+        parse_rate(&self.rate)
+    }
+}
+
+pub fn parse_rate(s: &str) -> anyhow::Result<RateChoice> {
+    let parts: Vec<&str> = s.split(':').collect();
+    let num = |p: &str| p.parse::<f32>().with_context(|| format!("--rate {s}: `{p}` is not a number"));
+    Ok(match parts.as_slice() {
+        ["backward"] => RateChoice::Backward,
+        ["filtered", fc] => RateChoice::Filtered(num(fc)?),
+        ["kalman"] => RateChoice::Kalman { q: 200.0, r: 0.01 },
+        ["kalman", q, r] => RateChoice::Kalman { q: num(q)?, r: num(r)? },
+        _ => bail!("--rate {s}: expected backward, filtered:FC_HZ or kalman[:Q:R]"),
+    })
+}
+
+/// Print one JSON object on stdout.
+pub fn print_json(v: &serde_json::Value) -> anyhow::Result<()> {
+    emit(&(serde_json::to_string_pretty(v)? + "\n"));
+    Ok(())
+}
+
+/// Write to stdout; a closed pipe (`hil-sim … | head`) ends the program quietly.
+pub fn emit(text: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("error: writing to stdout: {e}");
+        std::process::exit(1);
+    }
+}
+
+/// A progress bar on stderr (hidden when stderr is not a terminal or under `--json`
+/// piping; indicatif handles that).
+pub fn progress(len: u64, what: &str) -> indicatif::ProgressBar {
+    let pb = indicatif::ProgressBar::new(len);
+    pb.set_style(
+        indicatif::ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} {elapsed_precise}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    pb.set_message(what.to_owned());
+    pb
+}
+
+pub fn file_arg(p: &PathBuf) -> anyhow::Result<PathBuf> {
+    if p.is_file() {
+        Ok(p.clone())
+    } else {
+        bail!("{}: no such file", p.display())
+    }
+}

@@ -1,0 +1,47 @@
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+use hil_sim::params_file::ParamsFile;
+use hil_sim::recording::Recording;
+use hil_sim::replay::replay_recording;
+use serde_json::json;
+
+use super::ChannelArgs;
+
+#[derive(Args, Debug)]
+pub struct ReplayArgs {
+    /// Recording (CSV).
+    pub rec: PathBuf,
+    /// Parameter file (JSON: `{"model": ID, "params": {...}}`).
+    #[arg(long)]
+    pub params: PathBuf,
+    #[command(flatten)]
+    pub ch: ChannelArgs,
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
+    let pf = ParamsFile::read(&a.params)?;
+    let flat = pf.flat(&a.params)?;
+    let rec = Recording::read_csv(&super::file_arg(&a.rec)?)?;
+    let r = replay_recording(&rec, &a.ch.channels(), &pf.model, &flat, a.ch.rate()?)
+        .with_context(|| format!("replaying {}", a.rec.display()))?;
+    if a.json {
+        return super::print_json(&json!({
+            "model": r.model, "samples": r.samples, "dt_s": r.dt_s,
+            "metrics": r.metrics, "held": r.held,
+        }));
+    }
+    let m = &r.metrics;
+    super::emit(&format!(
+        "{}: {} samples at {:.1} Hz through `{}` (f32, one step per sample)\n",
+        a.rec.display(), r.samples, 1.0 / r.dt_s, r.model
+    ));
+    super::emit(&format!(
+        "  RMSE {:.4}  R-RMSE {:.2} %  R² {:.4}  GOF {:.4}  held samples {}\n",
+        m.rmse, 100.0 * m.r_rmse, m.r2, m.gof, r.held
+    ));
+    Ok(())
+}
