@@ -250,7 +250,8 @@ const HW_V: usize = HW_F + 5 + 3 * HW_NW + 2;
 fn stable_den() -> impl Strategy<Value = [f32; 5]> {
     (-0.98f64..0.98, -0.98f64..0.98, 0.0f64..0.98, 0.0f64..std::f64::consts::PI, -0.98f64..0.98).prop_map(
         |(r1, r2, rho, th, r5)| {
-            let roots = [(r1, 0.0), (r2, 0.0), (rho * th.cos(), rho * th.sin()), (rho * th.cos(), -rho * th.sin()), (r5, 0.0)];
+            let roots =
+                [(r1, 0.0), (r2, 0.0), (rho * th.cos(), rho * th.sin()), (rho * th.cos(), -rho * th.sin()), (r5, 0.0)];
             let mut c = vec![(1.0f64, 0.0f64)];
             for (re, im) in roots {
                 let mut n = vec![(0.0, 0.0); c.len() + 1];

@@ -54,7 +54,8 @@ impl Reference for BoucWenRef {
         let z = s.first().copied().unwrap_or(0.0);
         let xd = input.dx;
         let az = z.abs();
-        let zdot = self.delta * xd - self.beta * xd * az.powf(self.n) - self.gamma * xd.abs() * z * az.powf(self.n - 1.0);
+        let zdot =
+            self.delta * xd - self.beta * xd * az.powf(self.n) - self.gamma * xd.abs() * z * az.powf(self.n - 1.0);
         if let Some(d) = ds.first_mut() {
             *d = zdot;
         }
@@ -176,7 +177,8 @@ pub(crate) mod check {
         let kin = |i: &Input| Kin::new(i.x as f32, i.dx as f32, i.ddx as f32, 0.0);
         let mut ms = m.initial_state(&kin(&first));
         let n = r.dim();
-        let (mut k1, mut k2, mut k3, mut k4, mut tmp) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        let (mut k1, mut k2, mut k3, mut k4, mut tmp) =
+            (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         let h = dt / sub as f64;
         let (mut num, mut den) = (0.0, 0.0);
         let steps = (dur * fs).round() as usize;

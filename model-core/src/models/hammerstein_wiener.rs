@@ -236,7 +236,14 @@ impl<const NH: usize, const NW: usize> HammersteinWiener<NH, NW> {
         dt: f32,
     ) -> Result<Self, ParamError> {
         let dt = time_step(dt)?;
-        for (name, blk) in [("h_a", &h.a[..]), ("h_w", &h.w[..]), ("h_b", &h.b[..]), ("w_a", &w.a[..]), ("w_w", &w.w[..]), ("w_b", &w.b[..])] {
+        for (name, blk) in [
+            ("h_a", &h.a[..]),
+            ("h_w", &h.w[..]),
+            ("h_b", &h.b[..]),
+            ("w_a", &w.a[..]),
+            ("w_w", &w.w[..]),
+            ("w_b", &w.b[..]),
+        ] {
             for v in blk {
                 check(name, *v, -W_MAX, W_MAX)?;
             }
@@ -256,7 +263,9 @@ impl<const NH: usize, const NW: usize> HammersteinWiener<NH, NW> {
             return Err(ParamError::Constraint { what: "H-W v_min must be < v_max" });
         }
         if !schur_stable(&lin_f) {
-            return Err(ParamError::Constraint { what: "H-W linear block unstable: a pole of 1/F(q) is on or outside the unit circle" });
+            return Err(ParamError::Constraint {
+                what: "H-W linear block unstable: a pole of 1/F(q) is on or outside the unit circle",
+            });
         }
         Ok(Self { h, lin_b, lin_f, w, v_min, v_max, dt })
     }
@@ -465,7 +474,9 @@ mod tests {
     #[test]
     fn v_clamped_and_output_finite_on_huge_input() {
         let h = SigmoidNet { a: [1.0], w: [1.0], b: [0.0], lin: 1e6, d: 0.0 };
-        let m = HammersteinWiener::<1, 1>::new(h, [1e6, 1e6, 1e6], [-0.5, 0.0, 0.0, 0.0, 0.0], identity(), -5.0, 7.0, 1e-3).unwrap();
+        let m =
+            HammersteinWiener::<1, 1>::new(h, [1e6, 1e6, 1e6], [-0.5, 0.0, 0.0, 0.0, 0.0], identity(), -5.0, 7.0, 1e-3)
+                .unwrap();
         let mut s = State::default();
         for u in [1e30f32, -1e30, 3.0e38, -3.0e38, 1.0] {
             let y = m.step(&mut s, &Kin::new(u, 0.0, 0.0, 0.0));

@@ -18,7 +18,8 @@
 //! [`bouc_wen`](super::bouc_wen), the state keeps `B_{k−1}`, and an extremum of B inside the
 //! step (from the sample's Ḃ, B̈) splits the step into two monotone legs. The `ż` in the
 //! output is the analytic `α·(Ḃ − |Ḃ|·z)` at the end of the step with the sample's Ḃ.
-//! Error vs an f64 RK4 of the ODE: ~1e-6 relative (f32 round-off) at 500 Hz–3 kHz.
+//! Error vs fine f64 RK4 of the ODE (output R-RMSE, seed 000 Table 4 sets, sines 1–9 Hz,
+//! multi-sine, swept sine, 500 Hz and 3 kHz): ≤ 6e-7, i.e. f32 round-off.
 
 use crate::error::{check, count, finite, time_step};
 use crate::math::{abs, clamp, expm1};
