@@ -1,26 +1,518 @@
-//! PLACEHOLDER — to be replaced by the real `hammerstein_wiener` model.
-use crate::{Kin, Model, ParamError};
+//! Hammerstein–Wiener model, seed 000 eq. 15–17 and §6 (evaluator only; training lives in
+//! `hil-sim`):
+//!
+//! `x(t) = H(B(t))`,  `v(t) = [B(q)/F(q)]·x(t − 1)`,  `T(t) = W(v(t))`.
+//!
+//! - H and W are scalar sigmoid networks (MATLAB's `sigmoidnet` form)
+//!   `N(u) = lin·u + d + Σᵢ aᵢ·σ(wᵢ·u + bᵢ)`, `σ(s) = 1/(1 + e^{−s})`, with `NH` and `NW`
+//!   units. Seed 000 used wavelet networks; a sigmoid network is one of the toolbox's
+//!   options the paper lists, is cheaper on the Cortex-M4F (one `exp` per unit) and is
+//!   bounded apart from its linear term.
+//! - The linear block has two zeros, five poles and one sample of input delay (seed 000
+//!   §6): `v(t) = b₀x(t−1) + b₁x(t−2) + b₂x(t−3) − f₁v(t−1) − … − f₅v(t−5)`.
+//!
+//! # Parameters (flat vector order)
+//! `h_a[NH], h_w[NH], h_b[NH], h_lin, h_d, lin_b[3], lin_f[5], w_a[NW], w_w[NW], w_b[NW],
+//! w_lin, w_d, v_min, v_max` — `3·NH + 3·NW + 14` values; [`Registered`] (`NH = 14`,
+//! `NW = 13`) has 95, about seed 000's 94 units.
+//!
+//! # Guards
+//! `new` checks that every weight is finite with `|·| ≤ 1e6`, that `v_min < v_max`, and
+//! that `1 + f₁z⁻¹ + … + f₅z⁻⁵` has all poles strictly inside the unit circle (Schur–Cohn
+//! step-down recursion on the coefficients, in f64). In the step `x` is clamped to
+//! `±1e20` and `v` to `[v_min, v_max]` (a non-finite v holds the previous value), so the
+//! state stays finite for any finite input.
+//!
+//! The state starts at the steady state of the first sample (`x` repeated, `v` at the DC
+//! gain `Σb/(1 + Σf)` times x, clamped), so a constant input gives a constant output.
 
+use crate::error::{check, count, time_step};
+use crate::math::{clamp, exp};
+use crate::model::write_flat;
+use crate::{Finite, Kin, Model, ParamError};
+
+/// Largest admissible magnitude of any weight.
+pub const W_MAX: f32 = 1.0e6;
+/// Clamp of the Hammerstein output x.
+const X_LIM: f32 = 1.0e20;
+
+/// Logistic sigmoid `1/(1 + e^{−s})`, total (0 at −∞, 1 at +∞). Shared with `narx`.
+#[inline]
+pub(crate) fn sigmoid(s: f32) -> f32 {
+    1.0 / (1.0 + exp(-s))
+}
+
+/// A block name `base[len]` built at compile time (for const-generic `PARAM_NAMES`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BlockName {
+    buf: [u8; 32],
+    len: usize,
+}
+
+impl BlockName {
+    /// `base` (≤ 20 ASCII bytes) followed by `[len]`.
+    ///
+    /// Used only to initialise associated constants, i.e. evaluated by the compiler. The
+    /// indices stay in bounds by construction (≤ 20 + 1 + 10 + 1 = 32 bytes), and in const
+    /// evaluation an out-of-bounds index would be a compile error, not a run-time panic.
+    #[allow(clippy::indexing_slicing)]
+    pub(crate) const fn new(base: &str, n: usize) -> Self {
+        let mut buf = [0u8; 32];
+        let b = base.as_bytes();
+        let mut i = 0;
+        while i < b.len() && i < 20 {
+            buf[i] = b[i];
+            i += 1;
+        }
+        buf[i] = b'[';
+        i += 1;
+        let mut digits = [0u8; 10];
+        let mut nd = 0;
+        let mut v = n;
+        loop {
+            digits[nd] = b'0' + (v % 10) as u8;
+            nd += 1;
+            v /= 10;
+            if v == 0 || nd == digits.len() {
+                break;
+            }
+        }
+        while nd > 0 {
+            nd -= 1;
+            buf[i] = digits[nd];
+            i += 1;
+        }
+        buf[i] = b']';
+        i += 1;
+        Self { buf, len: i }
+    }
+
+    pub(crate) const fn as_str(&'static self) -> &'static str {
+        let (head, _) = self.buf.split_at(self.len);
+        match core::str::from_utf8(head) {
+            Ok(s) => s,
+            Err(_) => "?",
+        }
+    }
+}
+
+/// Read `N` values from a flat-vector iterator, validating each.
+pub(crate) fn take<const N: usize>(
+    it: &mut core::slice::Iter<'_, f32>,
+    name: &'static str,
+    lo: f32,
+    hi: f32,
+) -> Result<[f32; N], ParamError> {
+    let mut out = [0.0f32; N];
+    for o in out.iter_mut() {
+        let v = *it.next().ok_or(ParamError::Constraint { what: "parameter vector too short" })?;
+        *o = check(name, v, lo, hi)?;
+    }
+    Ok(out)
+}
+
+/// A scalar sigmoid network `lin·u + d + Σ aᵢ·σ(wᵢ·u + bᵢ)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Placeholder;
-pub type State = ();
-pub type Registered = Placeholder;
+pub struct SigmoidNet<const N: usize> {
+    pub a: [f32; N],
+    pub w: [f32; N],
+    pub b: [f32; N],
+    pub lin: f32,
+    pub d: f32,
+}
 
-impl Model for Placeholder {
-    type State = ();
+impl<const N: usize> SigmoidNet<N> {
+    /// Evaluate the network at `u`.
+    #[inline]
+    pub fn eval(&self, u: f32) -> f32 {
+        let mut y = self.lin * u + self.d;
+        for ((a, w), b) in self.a.iter().zip(self.w.iter()).zip(self.b.iter()) {
+            y += a * sigmoid(w * u + b);
+        }
+        y
+    }
+
+    fn read(it: &mut core::slice::Iter<'_, f32>, names: [&'static str; 5]) -> Result<Self, ParamError> {
+        let [na, nw, nb, nl, nd] = names;
+        Ok(Self {
+            a: take::<N>(it, na, -W_MAX, W_MAX)?,
+            w: take::<N>(it, nw, -W_MAX, W_MAX)?,
+            b: take::<N>(it, nb, -W_MAX, W_MAX)?,
+            lin: take::<1>(it, nl, -W_MAX, W_MAX)?[0],
+            d: take::<1>(it, nd, -W_MAX, W_MAX)?[0],
+        })
+    }
+
+    fn write<'a>(&self, out: &'a mut [f32]) -> (&'a mut [f32], usize) {
+        let mut n = 0;
+        let mut rest = out;
+        for block in [&self.a[..], &self.w[..], &self.b[..], &[self.lin], &[self.d]] {
+            let k = write_flat(block, rest);
+            n += k;
+            rest = rest.get_mut(k..).unwrap_or_default();
+        }
+        (rest, n)
+    }
+}
+
+/// True when every root of `zⁿ + a₁zⁿ⁻¹ + … + aₙ` lies strictly inside the unit circle
+/// (Schur–Cohn / Jury step-down: all reflection coefficients |kᵢ| < 1; a margin of 1e−6
+/// rejects poles on the circle up to the coefficients' f32 rounding).
+pub fn schur_stable(a: &[f32; 5]) -> bool {
+    let mut p = [1.0f64, 0.0, 0.0, 0.0, 0.0, 0.0];
+    for (d, s) in p.iter_mut().skip(1).zip(a.iter()) {
+        *d = f64::from(*s);
+    }
+    let mut m = p.len() - 1;
+    while m > 0 {
+        let k = p.get(m).copied().unwrap_or(0.0);
+        if !(k.abs() < 1.0 - 1.0e-6 && k.is_finite()) {
+            return false;
+        }
+        let den = 1.0 - k * k;
+        let mut q = [0.0f64; 6];
+        for i in 0..m {
+            let ai = p.get(i).copied().unwrap_or(0.0);
+            let ar = p.get(m - i).copied().unwrap_or(0.0);
+            if let Some(qi) = q.get_mut(i) {
+                *qi = (ai - k * ar) / den;
+            }
+        }
+        p = q;
+        m -= 1;
+    }
+    true
+}
+
+/// Coefficients of the H–W model with `NH` input and `NW` output sigmoid units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HammersteinWiener<const NH: usize, const NW: usize> {
+    /// Input nonlinearity H (eq. 15).
+    pub h: SigmoidNet<NH>,
+    /// Numerator b₀, b₁, b₂ (two zeros), acting on x(t−1), x(t−2), x(t−3).
+    pub lin_b: [f32; 3],
+    /// Denominator f₁ … f₅ of `1 + f₁q⁻¹ + … + f₅q⁻⁵` (five poles).
+    pub lin_f: [f32; 5],
+    /// Output nonlinearity W (eq. 17).
+    pub w: SigmoidNet<NW>,
+    /// Range the internal v is clamped to.
+    pub v_min: f32,
+    pub v_max: f32,
+    dt: f32,
+}
+
+/// Past values of the linear block: `xs = [x(t−1), x(t−2), x(t−3)]`, `vs = [v(t−1), …, v(t−5)]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct State {
+    pub xs: [f32; 3],
+    pub vs: [f32; 5],
+}
+
+impl Finite for State {
+    fn is_finite(&self) -> bool {
+        self.xs.is_finite() && self.vs.is_finite()
+    }
+}
+
+/// 14 + 13 sigmoid units: 95 parameters (seed 000: 94 units).
+pub type Registered = HammersteinWiener<14, 13>;
+
+impl<const NH: usize, const NW: usize> HammersteinWiener<NH, NW> {
+    const N_H_A: BlockName = BlockName::new("h_a", NH);
+    const N_H_W: BlockName = BlockName::new("h_w", NH);
+    const N_H_B: BlockName = BlockName::new("h_b", NH);
+    const N_W_A: BlockName = BlockName::new("w_a", NW);
+    const N_W_W: BlockName = BlockName::new("w_w", NW);
+    const N_W_B: BlockName = BlockName::new("w_b", NW);
+
+    /// Validate and build (see the module doc for the checks).
+    pub fn new(
+        h: SigmoidNet<NH>,
+        lin_b: [f32; 3],
+        lin_f: [f32; 5],
+        w: SigmoidNet<NW>,
+        v_min: f32,
+        v_max: f32,
+        dt: f32,
+    ) -> Result<Self, ParamError> {
+        let dt = time_step(dt)?;
+        for (name, blk) in [
+            ("h_a", &h.a[..]),
+            ("h_w", &h.w[..]),
+            ("h_b", &h.b[..]),
+            ("w_a", &w.a[..]),
+            ("w_w", &w.w[..]),
+            ("w_b", &w.b[..]),
+        ] {
+            for v in blk {
+                check(name, *v, -W_MAX, W_MAX)?;
+            }
+        }
+        for (name, v) in [("h_lin", h.lin), ("h_d", h.d), ("w_lin", w.lin), ("w_d", w.d)] {
+            check(name, v, -W_MAX, W_MAX)?;
+        }
+        for v in lin_b {
+            check("lin_b", v, -W_MAX, W_MAX)?;
+        }
+        for v in lin_f {
+            check("lin_f", v, -W_MAX, W_MAX)?;
+        }
+        let v_min = check("v_min", v_min, -1.0e15, 1.0e15)?;
+        let v_max = check("v_max", v_max, -1.0e15, 1.0e15)?;
+        if v_min >= v_max {
+            return Err(ParamError::Constraint { what: "H-W v_min must be < v_max" });
+        }
+        if !schur_stable(&lin_f) {
+            return Err(ParamError::Constraint {
+                what: "H-W linear block unstable: a pole of 1/F(q) is on or outside the unit circle",
+            });
+        }
+        Ok(Self { h, lin_b, lin_f, w, v_min, v_max, dt })
+    }
+
+    /// DC gain of the linear block, `Σb / (1 + Σf)`.
+    pub fn dc_gain(&self) -> f32 {
+        let nb: f32 = self.lin_b.iter().sum();
+        let df: f32 = 1.0 + self.lin_f.iter().sum::<f32>();
+        nb / df
+    }
+
+    #[inline]
+    fn clamp_v(&self, v: f32, hold: f32) -> f32 {
+        if v.is_nan() {
+            hold
+        } else {
+            clamp(v, self.v_min, self.v_max)
+        }
+    }
+}
+
+impl<const NH: usize, const NW: usize> Model for HammersteinWiener<NH, NW> {
+    type State = State;
     const ID: &'static str = "hammerstein_wiener";
-    const PARAM_NAMES: &'static [&'static str] = &[];
-    const N_PARAMS: usize = 0;
-    fn from_params(_v: &[f32], _dt: f32) -> Result<Self, ParamError> {
-        Ok(Self)
+    const PARAM_NAMES: &'static [&'static str] = &[
+        Self::N_H_A.as_str(),
+        Self::N_H_W.as_str(),
+        Self::N_H_B.as_str(),
+        "h_lin",
+        "h_d",
+        "lin_b[3]",
+        "lin_f[5]",
+        Self::N_W_A.as_str(),
+        Self::N_W_W.as_str(),
+        Self::N_W_B.as_str(),
+        "w_lin",
+        "w_d",
+        "v_min",
+        "v_max",
+    ];
+    const N_PARAMS: usize = 3 * NH + 3 * NW + 14;
+
+    fn from_params(v: &[f32], dt: f32) -> Result<Self, ParamError> {
+        count(v, Self::N_PARAMS)?;
+        let mut it = v.iter();
+        let h = SigmoidNet::<NH>::read(&mut it, ["h_a", "h_w", "h_b", "h_lin", "h_d"])?;
+        let lin_b = take::<3>(&mut it, "lin_b", -W_MAX, W_MAX)?;
+        let lin_f = take::<5>(&mut it, "lin_f", -W_MAX, W_MAX)?;
+        let w = SigmoidNet::<NW>::read(&mut it, ["w_a", "w_w", "w_b", "w_lin", "w_d"])?;
+        let [v_min] = take::<1>(&mut it, "v_min", f32::NEG_INFINITY, f32::INFINITY)?;
+        let [v_max] = take::<1>(&mut it, "v_max", f32::NEG_INFINITY, f32::INFINITY)?;
+        Self::new(h, lin_b, lin_f, w, v_min, v_max, dt)
     }
-    fn write_params(&self, _out: &mut [f32]) -> usize {
-        0
+
+    fn write_params(&self, out: &mut [f32]) -> usize {
+        let (rest, mut n) = self.h.write(out);
+        let k = write_flat(&self.lin_b, rest);
+        n += k;
+        let rest = rest.get_mut(k..).unwrap_or_default();
+        let k = write_flat(&self.lin_f, rest);
+        n += k;
+        let rest = rest.get_mut(k..).unwrap_or_default();
+        let (rest, k) = self.w.write(rest);
+        n += k;
+        n + write_flat(&[self.v_min, self.v_max], rest)
     }
+
     fn dt(&self) -> f32 {
-        1.0
+        self.dt
     }
-    fn step(&self, _s: &mut (), _k: &Kin) -> f32 {
-        0.0
+
+    fn initial_state(&self, first: &Kin) -> State {
+        let x = clamp(self.h.eval(first.x), -X_LIM, X_LIM);
+        let v = self.clamp_v(self.dc_gain() * x, 0.0);
+        let v = if v.is_finite() { v } else { 0.0 };
+        State { xs: [x; 3], vs: [v; 5] }
+    }
+
+    #[inline]
+    fn step(&self, s: &mut State, k: &Kin) -> f32 {
+        let x = clamp(self.h.eval(k.x), -X_LIM, X_LIM);
+        let [v1, v2, v3, v4, _] = s.vs;
+        let mut v = 0.0f32;
+        for (b, xp) in self.lin_b.iter().zip(s.xs.iter()) {
+            v += b * xp;
+        }
+        for (f, vp) in self.lin_f.iter().zip(s.vs.iter()) {
+            v -= f * vp;
+        }
+        let v = self.clamp_v(v, v1);
+        let [x1, x2, _] = s.xs;
+        s.xs = [x, x1, x2];
+        s.vs = [v, v1, v2, v3, v4];
+        self.w.eval(v)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+    use super::*;
+    use std::vec::Vec;
+
+    fn identity<const N: usize>() -> SigmoidNet<N> {
+        SigmoidNet { a: [0.0; N], w: [0.0; N], b: [0.0; N], lin: 1.0, d: 0.0 }
+    }
+
+    /// Monic polynomial coefficients a₁..a₅ from roots (real or conjugate pairs).
+    fn poly_from_roots(roots: &[(f64, f64)]) -> [f32; 5] {
+        // complex multiply out (z − r)
+        let mut c: Vec<(f64, f64)> = std::vec![(1.0, 0.0)];
+        for &(re, im) in roots {
+            let mut n = std::vec![(0.0, 0.0); c.len() + 1];
+            for (i, &(a, b)) in c.iter().enumerate() {
+                n[i].0 += a;
+                n[i].1 += b;
+                n[i + 1].0 -= a * re - b * im;
+                n[i + 1].1 -= a * im + b * re;
+            }
+            c = n;
+        }
+        let mut out = [0.0f32; 5];
+        for i in 0..5 {
+            out[i] = c[i + 1].0 as f32;
+        }
+        out
+    }
+
+    #[test]
+    fn schur_matches_roots() {
+        let stable = [(0.5, 0.0), (-0.3, 0.0), (0.2, 0.4), (0.2, -0.4), (0.95, 0.0)];
+        assert!(schur_stable(&poly_from_roots(&stable)));
+        let unstable = [(0.5, 0.0), (-0.3, 0.0), (0.2, 0.99), (0.2, -0.99), (0.9, 0.0)];
+        assert!(!schur_stable(&poly_from_roots(&unstable)));
+        assert!(!schur_stable(&poly_from_roots(&[(1.05, 0.0), (0.0, 0.0), (0.0, 0.0), (0.1, 0.0), (0.2, 0.0)])));
+        assert!(!schur_stable(&poly_from_roots(&[(-1.0, 0.0), (0.0, 0.0), (0.0, 0.0), (0.1, 0.0), (0.2, 0.0)])));
+        assert!(schur_stable(&[0.0; 5]));
+        // pseudo-random roots: classification must match max |root| < 1
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        for _ in 0..2000 {
+            let scale = 1.3;
+            let (r1, r2, re, im, r5) = (rnd() * scale, rnd() * scale, rnd() * scale, rnd() * scale, rnd() * scale);
+            let roots = [(r1, 0.0), (r2, 0.0), (re, im), (re, -im), (r5, 0.0)];
+            let maxmod = roots.iter().map(|(a, b)| (a * a + b * b).sqrt()).fold(0.0, f64::max);
+            if (maxmod - 1.0).abs() < 1e-3 {
+                continue;
+            }
+            assert_eq!(schur_stable(&poly_from_roots(&roots)), maxmod < 1.0, "{roots:?}");
+        }
+    }
+
+    #[test]
+    fn linear_block_difference_equation() {
+        // Identity nonlinearities: output = v, compare with the difference equation by hand.
+        let f = poly_from_roots(&[(0.5, 0.0), (-0.2, 0.0), (0.3, 0.3), (0.3, -0.3), (0.1, 0.0)]);
+        let b = [0.4f32, -0.1, 0.25];
+        let m = HammersteinWiener::<1, 1>::new(identity(), b, f, identity(), -1e6, 1e6, 1e-3).unwrap();
+        let mut s = State::default();
+        let u: Vec<f32> = (0..40).map(|i| if i == 0 { 0.0 } else { ((i * 7) % 5) as f32 - 2.0 }).collect();
+        let (mut xs, mut vs) = (std::vec![0.0f64; 45], std::vec![0.0f64; 45]);
+        for (t, &ut) in u.iter().enumerate() {
+            let y = m.step(&mut s, &Kin::new(ut, 0.0, 0.0, 0.0));
+            let t5 = t + 5;
+            xs[t5] = f64::from(ut);
+            let mut v = 0.0;
+            for j in 0..3 {
+                v += f64::from(b[j]) * xs[t5 - 1 - j];
+            }
+            for j in 0..5 {
+                v -= f64::from(f[j]) * vs[t5 - 1 - j];
+            }
+            vs[t5] = v;
+            assert!((f64::from(y) - v).abs() < 1e-5, "t={t}: {y} vs {v}");
+        }
+        // DC gain and steady start
+        let m2 = m;
+        let mut s = m2.initial_state(&Kin::new(2.0, 0.0, 0.0, 0.0));
+        for _ in 0..10 {
+            let y = m2.step(&mut s, &Kin::new(2.0, 0.0, 0.0, 0.0));
+            let want = 2.0 * (0.55 / (1.0 + f.iter().map(|x| f64::from(*x)).sum::<f64>()));
+            assert!((f64::from(y) - want).abs() < 1e-5, "{y} vs {want}");
+        }
+    }
+
+    #[test]
+    fn nonlinearities_hand_computed() {
+        let h = SigmoidNet { a: [2.0, -1.0], w: [1.5, 0.5], b: [0.1, -0.2], lin: 0.3, d: 0.05 };
+        let u = 0.7f64;
+        let sg = |s: f64| 1.0 / (1.0 + (-s).exp());
+        let want = 0.3 * u + 0.05 + 2.0 * sg(1.5 * u + 0.1) - sg(0.5 * u - 0.2);
+        assert!((f64::from(h.eval(u as f32)) - want).abs() < 1e-6);
+        // x(t) = H(B) enters v one sample later (input delay 1), output W(v).
+        let w = SigmoidNet { a: [1.0], w: [2.0], b: [0.0], lin: 0.0, d: 0.5 };
+        let m = HammersteinWiener::<2, 1>::new(h, [1.0, 0.0, 0.0], [0.0; 5], w, -10.0, 10.0, 1e-3).unwrap();
+        let mut s = State::default();
+        let y0 = m.step(&mut s, &Kin::new(0.7, 0.0, 0.0, 0.0));
+        assert!((f64::from(y0) - (0.5 + 0.5)).abs() < 1e-6, "v = 0 first: {y0}");
+        let y1 = m.step(&mut s, &Kin::new(-3.0, 0.0, 0.0, 0.0));
+        assert!((f64::from(y1) - (0.5 + sg(2.0 * want))).abs() < 1e-5);
+    }
+
+    #[test]
+    fn v_clamped_and_output_finite_on_huge_input() {
+        let h = SigmoidNet { a: [1.0], w: [1.0], b: [0.0], lin: 1e6, d: 0.0 };
+        let m =
+            HammersteinWiener::<1, 1>::new(h, [1e6, 1e6, 1e6], [-0.5, 0.0, 0.0, 0.0, 0.0], identity(), -5.0, 7.0, 1e-3)
+                .unwrap();
+        let mut s = State::default();
+        for u in [1e30f32, -1e30, 3.0e38, -3.0e38, 1.0] {
+            let y = m.step(&mut s, &Kin::new(u, 0.0, 0.0, 0.0));
+            assert!(y.is_finite() && (-5.0..=7.0).contains(&y));
+            assert!(s.is_finite());
+        }
+    }
+
+    #[test]
+    fn names_and_round_trip() {
+        let names = Registered::PARAM_NAMES;
+        assert_eq!(names[0], "h_a[14]");
+        assert_eq!(names[7], "w_a[13]");
+        // block lengths in the names add up to N_PARAMS
+        let total: usize = names
+            .iter()
+            .map(|n| n.split_once('[').map_or(1, |(_, r)| r.trim_end_matches(']').parse::<usize>().unwrap()))
+            .sum();
+        assert_eq!(total, Registered::N_PARAMS);
+        assert_eq!(Registered::N_PARAMS, 95);
+        let mut p: Vec<f32> = (0..95).map(|i| ((i * 37 % 11) as f32 - 5.0) * 0.1).collect();
+        // stable denominator and ordered v range
+        let f0 = 3 * 14 + 2 + 3;
+        p[f0..f0 + 5].copy_from_slice(&[0.1, -0.05, 0.02, 0.0, 0.01]);
+        p[93] = -50.0;
+        p[94] = 50.0;
+        let m = Registered::from_params(&p, 1e-3).unwrap();
+        let mut out = std::vec![0.0; 95];
+        assert_eq!(m.write_params(&mut out), 95);
+        assert_eq!(out, p);
+        let mut bad = p.clone();
+        bad[f0] = -2.5; // pole outside
+        assert!(Registered::from_params(&bad, 1e-3).is_err());
+        let mut bad = p.clone();
+        bad[93] = 60.0;
+        assert!(Registered::from_params(&bad, 1e-3).is_err());
+        assert!(Registered::from_params(&p[..94], 1e-3).is_err());
     }
 }

@@ -1,26 +1,357 @@
-//! PLACEHOLDER — to be replaced by the real `narx` model.
-use crate::{Kin, Model, ParamError};
+//! Nonlinear ARX model, seed 000 eq. 18–19, in simulation mode (evaluator only; training
+//! lives in `hil-sim`).
+//!
+//! Regressors (normalised): `r = [ŷ(t−1), û(t), û(t−1), …, û(t−5)]` with
+//! `û = (u − u_mean)/u_scale`, `ŷ = (y − y_mean)/y_scale`. The model output is
+//!
+//! `ŷ(t) = L·r + Σⱼ aⱼ·σ(wⱼ·r + bⱼ) + offset`,  `y(t) = clamp(y_mean + y_scale·ŷ(t), y_min, y_max)`,
+//!
+//! i.e. the linear mapping L of eq. 19 (7 weights W₁…W₇), the nonlinear mapping f of eq. 18
+//! and the offset. `y(t−1)` is the model's own previous (clamped) output.
+//!
+//! **Sigmoid instead of wavelet.** Seed 000 used MATLAB's wavelet network. Here f is a
+//! one-hidden-layer logistic sigmoid network (`σ(s) = 1/(1+e^{−s})`, MATLAB's
+//! `sigmoidnet`, one of the options the paper names): a universal approximator like the
+//! wavelet net, smooth for gradient training, one `exp` per unit on the Cortex-M4F (a
+//! radial wavelet needs an exp plus a norm per unit and a separate scaling-function part),
+//! and bounded, so the nonlinear part can never exceed `Σ|aⱼ|`.
+//!
+//! **Feedback clamp.** `W₁·y(t−1)` with `|W₁| ≥ 1` (or the net) could make the recursion
+//! diverge; the output — and hence what is fed back — is clamped to the validated range
+//! `[y_min, y_max]`. Normalised inputs are clamped to `±1e6`.
+//!
+//! # Parameters (flat vector order)
+//! `u_mean, u_scale, y_mean, y_scale, lin[7], hid_w[7·H] (unit-major: the 7 weights of unit
+//! 0, then unit 1, …), hid_b[H], out_a[H], offset, y_min, y_max` — `9·H + 14` values.
+//! [`Registered`] has `H = 71`: 653 values (seed 000's NARX: 656 units). Weights `|·| ≤ 1e6`,
+//! scales in `[1e−12, 1e12]`, `y_min < y_max`.
+//!
+//! State: the five past inputs (raw) and the last output. It starts at the first sample
+//! repeated and at the fixed point of the recursion for that constant input (32
+//! iterations of the clamped map from `y_mean`), so a constant input starts in steady state
+//! when the recursion converges.
 
+use crate::error::{check, count, time_step};
+use crate::math::clamp;
+use crate::model::write_flat;
+use crate::models::hammerstein_wiener::{sigmoid, take, BlockName, W_MAX};
+use crate::{Finite, Kin, Model, ParamError};
+
+/// Clamp of the normalised inputs.
+const U_LIM: f32 = 1.0e6;
+
+/// Coefficients of the NARX model with `H` hidden sigmoid units.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Placeholder;
-pub type State = ();
-pub type Registered = Placeholder;
+pub struct Narx<const H: usize> {
+    pub u_mean: f32,
+    pub u_scale: f32,
+    pub y_mean: f32,
+    pub y_scale: f32,
+    /// W₁…W₇ of eq. 19 (on ŷ(t−1), û(t), …, û(t−5)).
+    pub lin: [f32; 7],
+    /// Hidden-layer weights, one row of 7 per unit.
+    pub hid_w: [[f32; 7]; H],
+    pub hid_b: [f32; H],
+    pub out_a: [f32; H],
+    pub offset: f32,
+    pub y_min: f32,
+    pub y_max: f32,
+    dt: f32,
+}
 
-impl Model for Placeholder {
-    type State = ();
+/// Past inputs `u(t−1) … u(t−5)` (raw units) and the last output `y(t−1)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct State {
+    pub u: [f32; 5],
+    pub y: f32,
+}
+
+impl Finite for State {
+    fn is_finite(&self) -> bool {
+        self.u.is_finite() && self.y.is_finite()
+    }
+}
+
+/// 71 hidden units: 653 parameters (seed 000: 656 units).
+pub type Registered = Narx<71>;
+
+impl<const H: usize> Narx<H> {
+    const N_HID_W: BlockName = BlockName::new("hid_w", 7 * H);
+    const N_HID_B: BlockName = BlockName::new("hid_b", H);
+    const N_OUT_A: BlockName = BlockName::new("out_a", H);
+
+    /// Validate and build (bounds in the module doc).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        (u_mean, u_scale, y_mean, y_scale): (f32, f32, f32, f32),
+        lin: [f32; 7],
+        hid_w: [[f32; 7]; H],
+        hid_b: [f32; H],
+        out_a: [f32; H],
+        offset: f32,
+        (y_min, y_max): (f32, f32),
+        dt: f32,
+    ) -> Result<Self, ParamError> {
+        let dt = time_step(dt)?;
+        let u_mean = check("u_mean", u_mean, -1.0e15, 1.0e15)?;
+        let u_scale = check("u_scale", u_scale, 1.0e-12, 1.0e12)?;
+        let y_mean = check("y_mean", y_mean, -1.0e15, 1.0e15)?;
+        let y_scale = check("y_scale", y_scale, 1.0e-12, 1.0e12)?;
+        for v in lin {
+            check("lin", v, -W_MAX, W_MAX)?;
+        }
+        for row in &hid_w {
+            for v in row {
+                check("hid_w", *v, -W_MAX, W_MAX)?;
+            }
+        }
+        for v in hid_b {
+            check("hid_b", v, -W_MAX, W_MAX)?;
+        }
+        for v in out_a {
+            check("out_a", v, -W_MAX, W_MAX)?;
+        }
+        let offset = check("offset", offset, -W_MAX, W_MAX)?;
+        let y_min = check("y_min", y_min, -1.0e15, 1.0e15)?;
+        let y_max = check("y_max", y_max, -1.0e15, 1.0e15)?;
+        if y_min >= y_max {
+            return Err(ParamError::Constraint { what: "NARX y_min must be < y_max" });
+        }
+        Ok(Self { u_mean, u_scale, y_mean, y_scale, lin, hid_w, hid_b, out_a, offset, y_min, y_max, dt })
+    }
+
+    #[inline]
+    fn norm_u(&self, u: f32) -> f32 {
+        clamp((u - self.u_mean) / self.u_scale, -U_LIM, U_LIM)
+    }
+
+    /// One evaluation of eq. 18–19 from the previous output, the current input and the
+    /// five past inputs (raw units); returns the clamped output.
+    #[inline]
+    fn eval(&self, y_prev: f32, u: f32, past: &[f32; 5]) -> f32 {
+        let [p1, p2, p3, p4, p5] = *past;
+        let r = [
+            (y_prev - self.y_mean) / self.y_scale,
+            self.norm_u(u),
+            self.norm_u(p1),
+            self.norm_u(p2),
+            self.norm_u(p3),
+            self.norm_u(p4),
+            self.norm_u(p5),
+        ];
+        let dot = |w: &[f32; 7]| w.iter().zip(r.iter()).map(|(a, b)| a * b).sum::<f32>();
+        let mut yn = dot(&self.lin) + self.offset;
+        for ((w, b), a) in self.hid_w.iter().zip(self.hid_b.iter()).zip(self.out_a.iter()) {
+            yn += a * sigmoid(dot(w) + b);
+        }
+        clamp(self.y_mean + self.y_scale * yn, self.y_min, self.y_max)
+    }
+}
+
+impl<const H: usize> Model for Narx<H> {
+    type State = State;
     const ID: &'static str = "narx";
-    const PARAM_NAMES: &'static [&'static str] = &[];
-    const N_PARAMS: usize = 0;
-    fn from_params(_v: &[f32], _dt: f32) -> Result<Self, ParamError> {
-        Ok(Self)
+    const PARAM_NAMES: &'static [&'static str] = &[
+        "u_mean",
+        "u_scale",
+        "y_mean",
+        "y_scale",
+        "lin[7]",
+        Self::N_HID_W.as_str(),
+        Self::N_HID_B.as_str(),
+        Self::N_OUT_A.as_str(),
+        "offset",
+        "y_min",
+        "y_max",
+    ];
+    const N_PARAMS: usize = 9 * H + 14;
+
+    fn from_params(v: &[f32], dt: f32) -> Result<Self, ParamError> {
+        count(v, Self::N_PARAMS)?;
+        let inf = f32::INFINITY;
+        let mut it = v.iter();
+        let [u_mean] = take::<1>(&mut it, "u_mean", -inf, inf)?;
+        let [u_scale] = take::<1>(&mut it, "u_scale", -inf, inf)?;
+        let [y_mean] = take::<1>(&mut it, "y_mean", -inf, inf)?;
+        let [y_scale] = take::<1>(&mut it, "y_scale", -inf, inf)?;
+        let lin = take::<7>(&mut it, "lin", -inf, inf)?;
+        let mut hid_w = [[0.0f32; 7]; H];
+        for row in hid_w.iter_mut() {
+            *row = take::<7>(&mut it, "hid_w", -inf, inf)?;
+        }
+        let hid_b = take::<H>(&mut it, "hid_b", -inf, inf)?;
+        let out_a = take::<H>(&mut it, "out_a", -inf, inf)?;
+        let [offset] = take::<1>(&mut it, "offset", -inf, inf)?;
+        let [y_min] = take::<1>(&mut it, "y_min", -inf, inf)?;
+        let [y_max] = take::<1>(&mut it, "y_max", -inf, inf)?;
+        Self::new((u_mean, u_scale, y_mean, y_scale), lin, hid_w, hid_b, out_a, offset, (y_min, y_max), dt)
     }
-    fn write_params(&self, _out: &mut [f32]) -> usize {
-        0
+
+    fn write_params(&self, out: &mut [f32]) -> usize {
+        let mut n = 0;
+        let mut rest = out;
+        let mut put = |src: &[f32], rest: &mut &mut [f32]| {
+            let k = write_flat(src, rest);
+            n += k;
+            let r = core::mem::take(rest);
+            *rest = r.get_mut(k..).unwrap_or_default();
+        };
+        put(&[self.u_mean, self.u_scale, self.y_mean, self.y_scale], &mut rest);
+        put(&self.lin, &mut rest);
+        for row in &self.hid_w {
+            put(row, &mut rest);
+        }
+        put(&self.hid_b, &mut rest);
+        put(&self.out_a, &mut rest);
+        put(&[self.offset, self.y_min, self.y_max], &mut rest);
+        n
     }
+
     fn dt(&self) -> f32 {
-        1.0
+        self.dt
     }
-    fn step(&self, _s: &mut (), _k: &Kin) -> f32 {
-        0.0
+
+    fn initial_state(&self, first: &Kin) -> State {
+        let u0 = if first.x.is_finite() { first.x } else { self.u_mean };
+        let past = [u0; 5];
+        let mut y = clamp(self.y_mean, self.y_min, self.y_max);
+        for _ in 0..32 {
+            y = self.eval(y, u0, &past);
+        }
+        State { u: past, y }
+    }
+
+    #[inline]
+    fn step(&self, s: &mut State, k: &Kin) -> f32 {
+        let y = self.eval(s.y, k.x, &s.u);
+        let [p1, p2, p3, p4, _] = s.u;
+        s.u = [k.x, p1, p2, p3, p4];
+        s.y = y;
+        y
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+    use super::*;
+    use std::vec::Vec;
+
+    fn sg(s: f64) -> f64 {
+        1.0 / (1.0 + (-s).exp())
+    }
+
+    fn small() -> Narx<2> {
+        Narx::<2>::new(
+            (1.0, 2.0, 0.5, 4.0),
+            [0.6, 0.3, -0.2, 0.1, 0.05, -0.05, 0.02],
+            [[0.1, 0.2, 0.3, -0.1, 0.0, 0.5, -0.4], [-0.3, 0.1, 0.0, 0.2, 0.2, -0.1, 0.3]],
+            [0.1, -0.2],
+            [1.5, -0.7],
+            0.05,
+            (-100.0, 100.0),
+            1e-3,
+        )
+        .unwrap()
+    }
+
+    /// f64 re-implementation of eq. 18–19 with the same normalisation.
+    fn reference(m: &Narx<2>, u: &[f64], y0: f64, u0: f64) -> Vec<f64> {
+        let f = |v: f32| f64::from(v);
+        let mut hist = std::vec![u0; 5];
+        let mut y = y0;
+        let mut out = Vec::new();
+        for &ut in u {
+            let mut r = std::vec![(y - f(m.y_mean)) / f(m.y_scale), (ut - f(m.u_mean)) / f(m.u_scale)];
+            for h in &hist {
+                r.push((h - f(m.u_mean)) / f(m.u_scale));
+            }
+            let mut yn: f64 = m.lin.iter().zip(&r).map(|(a, b)| f(*a) * b).sum::<f64>() + f(m.offset);
+            for j in 0..2 {
+                let s: f64 = m.hid_w[j].iter().zip(&r).map(|(a, b)| f(*a) * b).sum::<f64>() + f(m.hid_b[j]);
+                yn += f(m.out_a[j]) * sg(s);
+            }
+            y = (f(m.y_mean) + f(m.y_scale) * yn).clamp(f(m.y_min), f(m.y_max));
+            hist.insert(0, ut);
+            hist.pop();
+            out.push(y);
+        }
+        out
+    }
+
+    #[test]
+    fn matches_eq18_19() {
+        let m = small();
+        let mut s = State { u: [0.0; 5], y: 0.0 };
+        let u: Vec<f64> = (0..50).map(|i| (i as f64 * 0.3).sin() * 2.0 + 1.0).collect();
+        let want = reference(&m, &u, 0.0, 0.0);
+        for (ut, w) in u.iter().zip(&want) {
+            let y = m.step(&mut s, &Kin::new(*ut as f32, 0.0, 0.0, 0.0));
+            assert!((f64::from(y) - w).abs() < 1e-4 * (1.0 + w.abs()), "{y} vs {w}");
+        }
+    }
+
+    #[test]
+    fn feedback_clamped() {
+        // W₁ = 3 makes the open recursion explode; the clamp keeps it in range.
+        let mut m = small();
+        m.lin[0] = 3.0;
+        let m = Narx::<2>::new(
+            (m.u_mean, m.u_scale, m.y_mean, m.y_scale),
+            m.lin,
+            m.hid_w,
+            m.hid_b,
+            m.out_a,
+            m.offset,
+            (-20.0, 30.0),
+            1e-3,
+        )
+        .unwrap();
+        let mut s = m.initial_state(&Kin::new(1.0, 0.0, 0.0, 0.0));
+        let mut hit = false;
+        for i in 0..500 {
+            let y = m.step(&mut s, &Kin::new((i as f32 * 0.1).sin(), 0.0, 0.0, 0.0));
+            assert!((-20.0..=30.0).contains(&y));
+            hit |= y == 30.0 || y == -20.0;
+        }
+        assert!(hit, "the recursion should have reached the clamp");
+        for u in [1e30f32, -1e30, 3e38] {
+            let y = m.step(&mut s, &Kin::new(u, 0.0, 0.0, 0.0));
+            assert!(y.is_finite() && s.is_finite());
+        }
+    }
+
+    #[test]
+    fn steady_start() {
+        let m = small();
+        let mut s = m.initial_state(&Kin::new(0.7, 0.0, 0.0, 0.0));
+        let y0 = s.y;
+        for _ in 0..5 {
+            let y = m.step(&mut s, &Kin::new(0.7, 0.0, 0.0, 0.0));
+            assert!((y - y0).abs() < 1e-4 * (1.0 + y0.abs()), "{y} vs {y0}");
+        }
+    }
+
+    #[test]
+    fn names_and_round_trip() {
+        assert_eq!(Registered::N_PARAMS, 653);
+        let total: usize = Registered::PARAM_NAMES
+            .iter()
+            .map(|n| n.split_once('[').map_or(1, |(_, r)| r.trim_end_matches(']').parse::<usize>().unwrap()))
+            .sum();
+        assert_eq!(total, Registered::N_PARAMS);
+        assert!(Registered::PARAM_NAMES.contains(&"hid_w[497]"));
+        let m = small();
+        let mut out = [0.0f32; 32];
+        assert_eq!(m.write_params(&mut out), 32);
+        let back = Narx::<2>::from_params(&out, 1e-3).unwrap();
+        assert_eq!(back, m);
+        let mut bad = out;
+        bad[1] = 0.0; // u_scale
+        assert!(Narx::<2>::from_params(&bad, 1e-3).is_err());
+        let mut bad = out;
+        bad[31] = -200.0; // y_max < y_min
+        assert!(Narx::<2>::from_params(&bad, 1e-3).is_err());
+        assert!(Narx::<2>::from_params(&out[..31], 1e-3).is_err());
     }
 }
