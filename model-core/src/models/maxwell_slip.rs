@@ -1,26 +1,238 @@
-//! PLACEHOLDER — to be replaced by the real `maxwell_slip` model.
-use crate::{Kin, Model, ParamError};
+//! Maxwell-slip model, seed 004 eq. 23–25 (de la Morena et al. 2025): `N` elasto-slide
+//! elements (a massless linear spring of stiffness `kᵢ` pulling a block with Coulomb
+//! breakaway force `fᵢ`) in parallel,
+//!
+//! `Fᵢ = kᵢ·(x − x_bᵢ)` while `|kᵢ·(x − x_bᵢ)| < fᵢ`, else `Fᵢ = fᵢ·sgn(ẋ)` and the block
+//! follows, `x_bᵢ = x − (fᵢ/kᵢ)·sgn(ẋ)`  (eq. 23–24),
+//!
+//! `Φ = w₀ + Σᵢ Fᵢ`  (eq. 25), here plus an optional linear term `k₀·x`
+//! (`k₀ = 0` is the paper's model).
+//!
+//! Exact per-step update: the state is each spring's deflection `dᵢ = x − x_bᵢ`. Over a
+//! step the input moves by `Δx`; a block only moves once its spring force reaches `fᵢ`,
+//! so `dᵢ ← clamp(dᵢ + Δx, −fᵢ/kᵢ, +fᵢ/kᵢ)`. This is eq. 23–24 with `sgn(ẋ) = sgn(Δx)`,
+//! rate-independent, and exact for any input that is monotone between samples. The
+//! deflections never leave `±fᵢ/kᵢ`.
+//!
+//! Units: x in the unit it was fitted in, `kᵢ` and `k₀` in output units per unit x,
+//! `fᵢ` and `w₀` in output units.
 
+use crate::error::{check, count, finite, time_step};
+use crate::math::clamp;
+use crate::model::write_flat;
+use crate::models::prandtl_ishlinskii::{block_names, operator_count, pick, to_array, MAX_OPERATORS};
+use crate::{Finite, Kin, Model, ParamError};
+
+const K_BLOCKS: [&str; MAX_OPERATORS + 1] = block_names!("k");
+const F_BLOCKS: [&str; MAX_OPERATORS + 1] = block_names!("f");
+
+/// Coefficients of eq. 23–25 with `N` elasto-slide elements.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Placeholder;
-pub type State = ();
-pub type Registered = Placeholder;
+pub struct MaxwellSlip<const N: usize> {
+    /// Output offset w₀ (output units).
+    pub w0: f32,
+    /// Spring stiffnesses kᵢ > 0 (output units per unit x).
+    pub k: [f32; N],
+    /// Breakaway forces fᵢ ≥ 0 (output units).
+    pub f: [f32; N],
+    /// Linear term k₀ (output units per unit x); 0 in seed 004.
+    pub k0: f32,
+    /// Deflection limits fᵢ/kᵢ (unit of x).
+    lim: [f32; N],
+    dt: f32,
+}
 
-impl Model for Placeholder {
-    type State = ();
+/// Previous input and the spring deflections `dᵢ = x − x_bᵢ` (unit of x).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct State<const N: usize> {
+    pub x_prev: f32,
+    pub d: [f32; N],
+}
+
+impl<const N: usize> Default for State<N> {
+    fn default() -> Self {
+        Self { x_prev: 0.0, d: [0.0; N] }
+    }
+}
+
+impl<const N: usize> Finite for State<N> {
+    fn is_finite(&self) -> bool {
+        self.x_prev.is_finite() && self.d.is_finite()
+    }
+}
+
+/// Seed 004 fits 10 elements (Table A15).
+pub type Registered = MaxwellSlip<10>;
+
+impl<const N: usize> MaxwellSlip<N> {
+    /// `kᵢ > 0`, `fᵢ ≥ 0` (seed 004 Table A15 bounds 0.01…10 and 0…10), `w₀`, `k₀` finite,
+    /// `1 ≤ N ≤ 64`.
+    pub fn new(w0: f32, k: [f32; N], f: [f32; N], k0: f32, dt: f32) -> Result<Self, ParamError> {
+        operator_count(N)?;
+        let mut lim = [0.0; N];
+        for ((l, ki), fi) in lim.iter_mut().zip(k).zip(f) {
+            let ki = check("k", ki, f32::MIN_POSITIVE, f32::MAX)?;
+            let fi = check("f", fi, 0.0, f32::MAX)?;
+            *l = fi / ki;
+            if !l.is_finite() {
+                return Err(ParamError::Constraint { what: "slip deflection f/k overflows" });
+            }
+        }
+        Ok(Self { w0: finite("w0", w0)?, k, f, k0: finite("k0", k0)?, lim, dt: time_step(dt)? })
+    }
+
+    /// Deflection limits `fᵢ/kᵢ` (unit of x): the state bound `|dᵢ| ≤ fᵢ/kᵢ`.
+    pub fn deflection_limits(&self) -> &[f32; N] {
+        &self.lim
+    }
+}
+
+impl<const N: usize> Model for MaxwellSlip<N> {
+    type State = State<N>;
     const ID: &'static str = "maxwell_slip";
-    const PARAM_NAMES: &'static [&'static str] = &[];
-    const N_PARAMS: usize = 0;
-    fn from_params(_v: &[f32], _dt: f32) -> Result<Self, ParamError> {
-        Ok(Self)
+    const PARAM_NAMES: &'static [&'static str] = &["w0", pick(&K_BLOCKS, N), pick(&F_BLOCKS, N), "k0"];
+    const N_PARAMS: usize = 2 + 2 * N;
+
+    fn from_params(v: &[f32], dt: f32) -> Result<Self, ParamError> {
+        count(v, Self::N_PARAMS)?;
+        let wrong = ParamError::WrongCount { expected: Self::N_PARAMS, got: v.len() };
+        let [w0, rest @ .., k0] = v else { return Err(wrong) };
+        let (k, f) = rest.split_at_checked(N).ok_or(wrong)?;
+        Self::new(*w0, to_array(k), to_array(f), *k0, dt)
     }
-    fn write_params(&self, _out: &mut [f32]) -> usize {
-        0
+
+    fn write_params(&self, out: &mut [f32]) -> usize {
+        let (head, rest) = out.split_at_mut(out.len().min(1));
+        let mut n = write_flat(&[self.w0], head);
+        let (ko, rest) = rest.split_at_mut(rest.len().min(N));
+        n += write_flat(&self.k, ko);
+        let (fo, rest) = rest.split_at_mut(rest.len().min(N));
+        n += write_flat(&self.f, fo);
+        n += write_flat(&[self.k0], rest);
+        n
     }
+
     fn dt(&self) -> f32 {
-        1.0
+        self.dt
     }
-    fn step(&self, _s: &mut (), _k: &Kin) -> f32 {
-        0.0
+
+    /// Springs relaxed (every block at the first input, `dᵢ = 0`).
+    fn initial_state(&self, first: &Kin) -> State<N> {
+        State { x_prev: first.x, d: [0.0; N] }
+    }
+
+    #[inline]
+    fn step(&self, s: &mut State<N>, k: &Kin) -> f32 {
+        let x = k.x;
+        let dx = x - s.x_prev;
+        s.x_prev = x;
+        let mut y = self.w0 + self.k0 * x;
+        for ((d, lim), ki) in s.d.iter_mut().zip(self.lim).zip(self.k) {
+            // NaN-safe: `clamp` maps NaN to the lower limit; ±∞ to the limits.
+            *d = clamp(*d + dx, -lim, lim);
+            y += ki * *d;
+        }
+        y
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+    use super::*;
+
+    fn kin(x: f32) -> Kin {
+        Kin::new(x, 0.0, 0.0, 0.0)
+    }
+
+    /// One elasto-slide element against eq. 23–24 written out with block positions.
+    #[test]
+    fn element_matches_eq23_24() {
+        let (k, f) = (2.0f32, 1.0f32);
+        let m = MaxwellSlip::new(0.0, [k], [f], 0.0, 1e-3).unwrap();
+        let xs = [0.0f32, 0.25, 0.5, 1.0, 0.8, 0.5, 0.0, -0.5, -0.25, 0.3];
+        let mut s = m.initial_state(&kin(xs[0]));
+        // Textbook reference with the block position x_b.
+        let mut xb = xs[0];
+        let mut xprev = xs[0];
+        for &x in &xs {
+            let y = m.step(&mut s, &kin(x));
+            let trial = k * (x - xb);
+            let want = if trial.abs() < f {
+                trial
+            } else {
+                let sg = (x - xprev).signum();
+                xb = x - f / k * sg;
+                f * sg
+            };
+            xprev = x;
+            assert!((y - want).abs() < 1e-6, "x={x}: {y} vs {want}");
+        }
+        // Hand values: rising to 1.0 saturates at f; back at 0.5 the spring is relaxed.
+        let mut s = m.initial_state(&kin(0.0));
+        for (x, w) in [(0.25, 0.5), (1.0, 1.0), (0.5, 0.0), (0.0, -1.0)] {
+            let y = m.step(&mut s, &kin(x));
+            assert!((y - w).abs() < 1e-6, "x={x}: {y} vs {w}");
+        }
+    }
+
+    #[test]
+    fn sum_offset_linear_term_and_bounds() {
+        let m = MaxwellSlip::new(0.1, [1.0, 10.0], [0.5, 0.2], 0.3, 1e-3).unwrap();
+        let mut s = m.initial_state(&kin(0.0));
+        // x = 0.04: element 1 elastic (0.04 < 0.5/1), element 2 slips at f = 0.2
+        // (its deflection limit is 0.2/10 = 0.02): 0.1 + 0.3·0.04 + 0.04 + 0.2
+        let y = m.step(&mut s, &kin(0.04));
+        assert!((y - (0.1 + 0.012 + 0.04 + 0.2)).abs() < 1e-6, "{y}");
+        // x = 0.03: element 2 unloads elastically from +0.02 to +0.01.
+        let y = m.step(&mut s, &kin(0.03));
+        assert!((y - (0.1 + 0.009 + 0.03 + 0.1)).abs() < 1e-6, "{y}");
+        // x = 1e30 then back: deflections never exceed f/k.
+        m.step(&mut s, &kin(1e30));
+        assert_eq!(s.d, [0.5, 0.02]);
+        m.step(&mut s, &kin(-1e30));
+        assert_eq!(s.d, [-0.5, -0.02]);
+    }
+
+    /// The loop of an elasto-slide element is clockwise (seed 004 §5): the rising branch
+    /// (F = +f once sliding) lies above the falling branch (F = −f).
+    #[test]
+    fn loop_is_clockwise() {
+        let m = MaxwellSlip::new(0.0, [1.0], [0.2], 0.0, 1e-3).unwrap();
+        let mut s = m.initial_state(&kin(-1.0));
+        let n = 200;
+        let mut up = 0.0;
+        let mut down = 0.0;
+        for cycle in 0..2 {
+            for i in 0..=2 * n {
+                let x = if i <= n { -1.0 + 2.0 * i as f32 / n as f32 } else { 3.0 - 2.0 * i as f32 / n as f32 };
+                let y = m.step(&mut s, &kin(x));
+                if cycle == 1 && i == n / 2 {
+                    up = y;
+                }
+                if cycle == 1 && i == 3 * n / 2 {
+                    down = y;
+                }
+            }
+        }
+        // Both samples at x = 0.
+        assert!(up > down, "up {up} down {down}");
+        assert!((up - 0.2).abs() < 1e-6 && (down + 0.2).abs() < 1e-6);
+    }
+
+    #[test]
+    fn rejects_bad_params() {
+        assert!(MaxwellSlip::new(0.0, [0.0], [1.0], 0.0, 1e-3).is_err());
+        assert!(MaxwellSlip::new(0.0, [1.0], [-1.0], 0.0, 1e-3).is_err());
+        assert!(MaxwellSlip::new(f32::INFINITY, [1.0], [1.0], 0.0, 1e-3).is_err());
+        type M = MaxwellSlip<2>;
+        assert_eq!(M::PARAM_NAMES, &["w0", "k[2]", "f[2]", "k0"]);
+        let v = [0.1, 1.0, 2.0, 0.5, 0.6, 0.3];
+        let m = M::from_params(&v, 1e-3).unwrap();
+        assert_eq!((m.k, m.f, m.k0), ([1.0, 2.0], [0.5, 0.6], 0.3));
+        let mut out = [0.0; 6];
+        assert_eq!(m.write_params(&mut out), 6);
+        assert_eq!(out, v);
+        assert!(M::from_params(&v[..5], 1e-3).is_err());
     }
 }

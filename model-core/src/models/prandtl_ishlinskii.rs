@@ -1,26 +1,473 @@
-//! PLACEHOLDER — to be replaced by the real `prandtl_ishlinskii` model.
-use crate::{Kin, Model, ParamError};
+//! Classical Prandtl–Ishlinskii (CPI) model, seed 004 eq. 10–15 (de la Morena et al. 2025):
+//!
+//! `Φ[x](t) = p₀·x(t) + Σᵢ pᵢ·Γ_{rᵢ}[x](t)`  (eq. 15)
+//!
+//! with the play operator of radius `r ≥ 0` (eq. 10–11)
+//!
+//! `Γ_r[x](t_k) = max{x(t_k) − r, min{x(t_k) + r, Γ_r[x](t_{k−1})}}`,
+//! `Γ_r[x](0) = max{x(0) − r, min{x(0) + r, M₀}}`.
+//!
+//! The model is rate-independent and exact at any sample rate (the play operator is
+//! defined on the sampled input). x in the unit the parameters were fitted in (seed 004
+//! normalises the input to 0…1; here the Hall flux density B), `rᵢ` and `M₀` in the unit
+//! of x, `p₀` and `pᵢ` in output units per unit x. Radii and weights are free (seed 004
+//! Tables A7–A8 fit them unsorted, some zero); one initial condition `M₀` is shared by
+//! every play operator as in the paper.
+//!
+//! The inverse model ([`PrandtlIshlinskii::inverse`]) is again a PI model with play
+//! operators on the output; see [`Inverse`].
 
+use crate::error::{check, count, finite, time_step};
+use crate::model::write_flat;
+use crate::{Finite, Kin, Model, ParamError};
+
+/// Largest operator count with a parameter name table (`r[N]`, `p[N]`).
+pub const MAX_OPERATORS: usize = 64;
+
+/// Generates `["name[0]", "name[1]", …, "name[64]"]` for block parameter names.
+macro_rules! block_names {
+    ($name:literal) => {
+        $crate::models::prandtl_ishlinskii::block_names!(@ $name;
+            0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30
+            31 32 33 34 35 36 37 38 39 40 41 42 43 44 45 46 47 48 49 50 51 52 53 54 55 56 57 58
+            59 60 61 62 63 64)
+    };
+    (@ $name:literal; $($n:literal)*) => {
+        [$(concat!($name, "[", $n, "]")),*]
+    };
+}
+pub(crate) use block_names;
+
+/// Entry `n` of a name table in a const context (`"?"` past its end).
+pub(crate) const fn pick(mut table: &'static [&'static str], mut n: usize) -> &'static str {
+    while let [first, rest @ ..] = table {
+        if n == 0 {
+            return first;
+        }
+        n -= 1;
+        table = rest;
+    }
+    "?"
+}
+
+const R_BLOCKS: [&str; MAX_OPERATORS + 1] = block_names!("r");
+const P_BLOCKS: [&str; MAX_OPERATORS + 1] = block_names!("p");
+
+/// One play operator step, eq. 10: `max{x − r, min{x + r, prev}}`.
+///
+/// The result always lies in `[x − r, x + r]` (for `r ≥ 0`).
+#[inline(always)]
+pub fn play(x: f32, r: f32, prev: f32) -> f32 {
+    (x + r).min(prev).max(x - r)
+}
+
+/// Coefficients of eq. 15 with `N` play operators.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Placeholder;
-pub type State = ();
-pub type Registered = Placeholder;
+pub struct PrandtlIshlinskii<const N: usize> {
+    /// Linear (non-hysteretic) gain p₀ ≥ 0, output units per unit x.
+    pub p0: f32,
+    /// Initial condition M₀ of every play operator (eq. 11), unit of x.
+    pub m0: f32,
+    /// Radii rᵢ ≥ 0 (any order, repeats allowed), unit of x.
+    pub r: [f32; N],
+    /// Weights pᵢ ≥ 0, output units per unit x.
+    pub p: [f32; N],
+    dt: f32,
+}
 
-impl Model for Placeholder {
-    type State = ();
+/// Outputs of the `N` play operators (unit of x).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct State<const N: usize> {
+    pub z: [f32; N],
+}
+
+impl<const N: usize> Default for State<N> {
+    fn default() -> Self {
+        Self { z: [0.0; N] }
+    }
+}
+
+impl<const N: usize> Finite for State<N> {
+    fn is_finite(&self) -> bool {
+        self.z.is_finite()
+    }
+}
+
+/// Seed 004 fits 5 and 10 operators (Tables A7, A8); 10 is the registered size.
+pub type Registered = PrandtlIshlinskii<10>;
+
+impl<const N: usize> PrandtlIshlinskii<N> {
+    /// Paper form: `p₀ ≥ 0`, `M₀` finite, radii `rᵢ ≥ 0`, weights `pᵢ ≥ 0` (seed 004's
+    /// bounds, Tables A7–A8). `1 ≤ N ≤ 64`.
+    pub fn new(p0: f32, m0: f32, r: [f32; N], p: [f32; N], dt: f32) -> Result<Self, ParamError> {
+        operator_count(N)?;
+        for v in r {
+            check("r", v, 0.0, f32::MAX)?;
+        }
+        for v in p {
+            check("p", v, 0.0, f32::MAX)?;
+        }
+        Ok(Self { p0: check("p0", p0, 0.0, f32::MAX)?, m0: finite("m0", m0)?, r, p, dt: time_step(dt)? })
+    }
+
+    /// The analytical inverse (a PI model on the output), see [`Inverse`].
+    ///
+    /// Needs `p₀ > 0`: with `p₀ = 0` the model saturates once every play operator
+    /// moves and has no inverse beyond that.
+    pub fn inverse(&self) -> Result<Inverse<N>, ParamError> {
+        Inverse::of(self)
+    }
+}
+
+/// `1 ≤ n ≤ MAX_OPERATORS`.
+pub(crate) fn operator_count(n: usize) -> Result<(), ParamError> {
+    if n == 0 || n > MAX_OPERATORS {
+        Err(ParamError::Constraint { what: "operator count must be 1..=64" })
+    } else {
+        Ok(())
+    }
+}
+
+/// Copy `src` into a fixed array (length checked by the caller).
+pub(crate) fn to_array<const N: usize>(src: &[f32]) -> [f32; N] {
+    let mut a = [0.0; N];
+    for (o, s) in a.iter_mut().zip(src) {
+        *o = *s;
+    }
+    a
+}
+
+impl<const N: usize> Model for PrandtlIshlinskii<N> {
+    type State = State<N>;
     const ID: &'static str = "prandtl_ishlinskii";
-    const PARAM_NAMES: &'static [&'static str] = &[];
-    const N_PARAMS: usize = 0;
-    fn from_params(_v: &[f32], _dt: f32) -> Result<Self, ParamError> {
-        Ok(Self)
+    const PARAM_NAMES: &'static [&'static str] = &["p0", "m0", pick(&R_BLOCKS, N), pick(&P_BLOCKS, N)];
+    const N_PARAMS: usize = 2 + 2 * N;
+
+    fn from_params(v: &[f32], dt: f32) -> Result<Self, ParamError> {
+        count(v, Self::N_PARAMS)?;
+        let wrong = ParamError::WrongCount { expected: Self::N_PARAMS, got: v.len() };
+        let [p0, m0, rest @ ..] = v else { return Err(wrong) };
+        let (r, p) = rest.split_at_checked(N).ok_or(wrong)?;
+        Self::new(*p0, *m0, to_array(r), to_array(p), dt)
     }
-    fn write_params(&self, _out: &mut [f32]) -> usize {
-        0
+
+    fn write_params(&self, out: &mut [f32]) -> usize {
+        let (head, rest) = out.split_at_mut(out.len().min(2));
+        let mut n = write_flat(&[self.p0, self.m0], head);
+        let (ro, po) = rest.split_at_mut(rest.len().min(N));
+        n += write_flat(&self.r, ro);
+        n += write_flat(&self.p, po);
+        n
     }
+
     fn dt(&self) -> f32 {
-        1.0
+        self.dt
     }
-    fn step(&self, _s: &mut (), _k: &Kin) -> f32 {
-        0.0
+
+    /// Eq. 11: every play operator starts from `M₀`, confined to `[x(0) − r, x(0) + r]`.
+    fn initial_state(&self, first: &Kin) -> State<N> {
+        let mut s = State::default();
+        for (z, r) in s.z.iter_mut().zip(self.r) {
+            *z = play(first.x, r, self.m0);
+        }
+        s
+    }
+
+    #[inline]
+    fn step(&self, s: &mut State<N>, k: &Kin) -> f32 {
+        let x = k.x;
+        let mut y = self.p0 * x;
+        for ((z, r), p) in s.z.iter_mut().zip(self.r).zip(self.p) {
+            *z = play(x, r, *z);
+            y += p * *z;
+        }
+        y
+    }
+}
+
+/// Inverse of a classical PI model: `x = p̂₀·y + Σⱼ p̂ⱼ·Γ_{r̂ⱼ}[y]`.
+///
+/// With the operators sorted by radius, `0 ≤ r₁ ≤ … ≤ r_N`, and the partial sums
+/// `Pⱼ = p₀ + p₁ + … + pⱼ` (so `P₀ = p₀`), the inverse thresholds and weights are the
+/// standard ones (Krasnosel'skii–Pokrovskii; Kuhnen 2003):
+///
+/// `p̂₀ = 1/p₀`, `r̂ⱼ = Σ_{i=0..j} pᵢ·(rⱼ − rᵢ)` (with `r₀ = 0`),
+/// `p̂ⱼ = −pⱼ / (Pⱼ·Pⱼ₋₁)`.
+///
+/// `y` in output units, `r̂ⱼ` in output units, `p̂ⱼ` in units of x per output unit.
+/// The inverse's play states that correspond to a forward state `zᵢ` are
+/// `ẑⱼ = Pⱼ·zⱼ + Σ_{i>j} pᵢ·zᵢ` ([`Inverse::state_from`]); started from those, the
+/// inverse reproduces the forward model's input exactly (up to rounding) on any path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inverse<const N: usize> {
+    /// p̂₀ = 1/p₀.
+    pub q0: f32,
+    /// Inverse radii r̂ⱼ, ascending (output units).
+    pub r: [f32; N],
+    /// Inverse weights p̂ⱼ ≤ 0.
+    pub q: [f32; N],
+    /// Forward operator index of sorted position j.
+    order: [usize; N],
+    /// Forward partial sums Pⱼ (sorted order).
+    partial: [f32; N],
+    /// Forward weights in sorted order.
+    p_sorted: [f32; N],
+}
+
+/// Play operator states of the inverse model (output units).
+pub type InverseState<const N: usize> = State<N>;
+
+impl<const N: usize> Inverse<N> {
+    fn of(m: &PrandtlIshlinskii<N>) -> Result<Self, ParamError> {
+        if m.p0 <= 0.0 {
+            return Err(ParamError::Constraint { what: "PI inverse needs p0 > 0" });
+        }
+        let mut idx = [0usize; N];
+        for (i, v) in idx.iter_mut().enumerate() {
+            *v = i;
+        }
+        let mut pairs = [(0.0f32, 0.0f32, 0usize); N];
+        for ((o, (r, p)), i) in pairs.iter_mut().zip(m.r.iter().zip(m.p.iter())).zip(idx) {
+            *o = (*r, *p, i);
+        }
+        pairs.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.2.cmp(&b.2)));
+
+        let mut inv =
+            Self { q0: 1.0 / m.p0, r: [0.0; N], q: [0.0; N], order: [0; N], partial: [0.0; N], p_sorted: [0.0; N] };
+        // Running sums in f64 so the inverse is as exact as the f32 coefficients allow.
+        let mut prev_sum = f64::from(m.p0);
+        // Σ_{i≤j} pᵢ·rᵢ including i = 0 (r₀ = 0).
+        let mut pr_sum = 0.0f64;
+        for (j, &(rj, pj, i)) in pairs.iter().enumerate() {
+            let (rj, pj) = (f64::from(rj), f64::from(pj));
+            let sum = prev_sum + pj;
+            pr_sum += pj * rj;
+            let rhat = sum * rj - pr_sum;
+            let qhat = -pj / (sum * prev_sum);
+            if let (Some(r), Some(q), Some(o), Some(ps), Some(pp)) = (
+                inv.r.get_mut(j),
+                inv.q.get_mut(j),
+                inv.order.get_mut(j),
+                inv.partial.get_mut(j),
+                inv.p_sorted.get_mut(j),
+            ) {
+                *r = rhat as f32;
+                *q = qhat as f32;
+                *o = i;
+                *ps = sum as f32;
+                *pp = pj as f32;
+            }
+            prev_sum = sum;
+        }
+        let all_finite = inv.q0.is_finite() && inv.r.is_finite() && inv.q.is_finite();
+        if !all_finite {
+            return Err(ParamError::Constraint { what: "PI inverse coefficients overflow" });
+        }
+        Ok(inv)
+    }
+
+    /// Inverse state matching a forward state (play outputs `fwd.z` in forward order).
+    pub fn state_from(&self, fwd: &State<N>) -> InverseState<N> {
+        let mut zs = [0.0f32; N];
+        for (o, &i) in zs.iter_mut().zip(self.order.iter()) {
+            *o = fwd.z.get(i).copied().unwrap_or(0.0);
+        }
+        let mut out = State::default();
+        // tail = Σ_{i>j} pᵢ zᵢ, built from the end.
+        let mut tail = 0.0f32;
+        for (((o, &z), &pj), &sum) in
+            out.z.iter_mut().zip(zs.iter()).zip(self.p_sorted.iter()).zip(self.partial.iter()).rev()
+        {
+            *o = sum * z + tail;
+            tail += pj * z;
+        }
+        out
+    }
+
+    /// Inverse state when every forward play operator is relaxed at the current input
+    /// (forward `zᵢ = x`): every inverse play starts at the output `y`.
+    pub fn relaxed_state(&self, y: f32) -> InverseState<N> {
+        State { z: [y; N] }
+    }
+
+    /// Input that produces the output `y` (feed-forward: the desired torque in, the
+    /// flux density to command out). Cannot fail; finite `y` gives a finite result.
+    #[inline]
+    pub fn step(&self, s: &mut InverseState<N>, y: f32) -> f32 {
+        let mut x = self.q0 * y;
+        for ((z, r), q) in s.z.iter_mut().zip(self.r).zip(self.q) {
+            *z = play(y, r, *z);
+            x += q * *z;
+        }
+        x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::expect_used)]
+    use super::*;
+
+    fn kin(x: f32) -> Kin {
+        Kin::new(x, 0.0, 0.0, 0.0)
+    }
+
+    #[test]
+    fn names_and_count() {
+        type M = PrandtlIshlinskii<10>;
+        assert_eq!(M::PARAM_NAMES, &["p0", "m0", "r[10]", "p[10]"]);
+        assert_eq!(M::N_PARAMS, 22);
+        assert_eq!(PrandtlIshlinskii::<3>::PARAM_NAMES, &["p0", "m0", "r[3]", "p[3]"]);
+    }
+
+    /// Textbook play operator: backlash of half-width r.
+    #[test]
+    fn play_operator_textbook() {
+        let r = 0.25;
+        let mut z = 0.0;
+        // Rising from 0: output stays until x − r exceeds it.
+        let xs = [0.0, 0.1, 0.25, 0.5, 1.0, 0.8, 0.5, 0.4, 0.0, -0.2];
+        let want = [0.0, 0.0, 0.0, 0.25, 0.75, 0.75, 0.75, 0.65, 0.25, 0.05];
+        for (x, w) in xs.iter().zip(want) {
+            z = play(*x, r, z);
+            assert!((z - w).abs() < 1e-6, "x={x}: {z} vs {w}");
+        }
+    }
+
+    /// Eq. 15 by hand for two operators.
+    #[test]
+    fn matches_eq15_by_hand() {
+        let m = PrandtlIshlinskii::new(0.5, 0.0, [0.1, 0.3], [2.0, 1.0], 1e-3).unwrap();
+        let mut s = m.initial_state(&kin(0.0));
+        assert_eq!(s.z, [0.0, 0.0]);
+        // x = 0.5: plays 0.4 and 0.2 → 0.25 + 0.8 + 0.2
+        let y = m.step(&mut s, &kin(0.5));
+        assert!((y - (0.25 + 2.0 * 0.4 + 0.2)).abs() < 1e-6);
+        // x = 0.35: play 1 holds 0.4 (0.35+0.1 ≥ 0.4), play 2 holds 0.2
+        let y = m.step(&mut s, &kin(0.35));
+        assert!((y - (0.175 + 0.8 + 0.2)).abs() < 1e-6);
+        // x = 0.0: play 1 → 0.1, play 2 → 0.2 (0.0 + 0.3 ≥ 0.2)
+        let y = m.step(&mut s, &kin(0.0));
+        assert!((y - (0.0 + 0.2 + 0.2)).abs() < 1e-6, "{y}");
+    }
+
+    #[test]
+    fn initial_condition_eq11() {
+        let m = PrandtlIshlinskii::new(0.3, 0.1062, [0.05, 0.5], [1.0, 1.0], 1e-3).unwrap();
+        let s = m.initial_state(&kin(0.8));
+        // max(0.8 − 0.05, min(0.85, 0.1062)) = 0.75; max(0.3, min(1.3, 0.1062)) = 0.3
+        assert!((s.z[0] - 0.75).abs() < 1e-6 && (s.z[1] - 0.3).abs() < 1e-6, "{:?}", s.z);
+    }
+
+    /// For a symmetric periodic input the CPI loop is point-symmetric about its centre:
+    /// half a period later the input is mirrored and so is the output.
+    #[test]
+    fn loop_is_point_symmetric() {
+        // Seed 004 Table A8 (CPI, 10 operators).
+        let r = [0.8438, 0.6037, 0.0314, 0.0234, 0.0176, 0.0215, 0.0156, 0.0826, 0.0805, 0.0001];
+        let p = [0.0006, 0.0180, 0.0430, 0.0035, 0.0156, 0.5756, 0.1777, 0.6034, 0.0163, 0.0156];
+        let m = PrandtlIshlinskii::new(0.0610, 0.0862, r, p, 1e-3).unwrap();
+        let n = 400usize;
+        let c = 0.5f32;
+        let amp = 0.5f32;
+        let x = |i: usize| c + amp * (2.0 * core::f32::consts::PI * (i % n) as f32 / n as f32).sin();
+        let mut s = m.initial_state(&kin(x(0)));
+        let mut ys = Vec::new();
+        for i in 0..4 * n {
+            ys.push(m.step(&mut s, &kin(x(i))));
+        }
+        let last = &ys[3 * n..];
+        let yc = last.iter().sum::<f32>() / n as f32;
+        let range = last.iter().cloned().fold(f32::MIN, f32::max) - last.iter().cloned().fold(f32::MAX, f32::min);
+        let asym = asymmetry_index(last, yc, range);
+        assert!(asym < 1e-3, "CPI loop asymmetry {asym}");
+        // A real loop: at the centre input the rising and falling outputs differ.
+        let width = (last[0] - last[n / 2]).abs();
+        assert!(width > 0.05 * range, "loop width {width} of range {range}");
+        // Control: the index does see an offset branch (shift the falling half).
+        let mut skewed = last.to_vec();
+        for v in &mut skewed[n / 2..] {
+            *v += 0.05 * range;
+        }
+        assert!(asymmetry_index(&skewed, yc, range) > 0.01);
+    }
+
+    /// max_t |y(t) + y(t + T/2) − 2·ȳ| / range over one period of `n` samples.
+    pub(crate) fn asymmetry_index(y: &[f32], yc: f32, range: f32) -> f32 {
+        let n = y.len();
+        (0..n / 2).map(|i| (y[i] + y[i + n / 2] - 2.0 * yc).abs()).fold(0.0, f32::max) / range
+    }
+
+    #[test]
+    fn inverse_coefficients_by_hand() {
+        // p0 = 1, (r, p) = (0.1, 1), (0.3, 2) → P = 1, 2, 4.
+        let m = PrandtlIshlinskii::new(1.0, 0.0, [0.3, 0.1], [2.0, 1.0], 1e-3).unwrap();
+        let inv = m.inverse().unwrap();
+        assert!((inv.q0 - 1.0).abs() < 1e-7);
+        // r̂₁ = 1·0.1 + 1·0 = 0.1; r̂₂ = 1·0.3 + 1·(0.3 − 0.1) + 2·0 = 0.5
+        assert!((inv.r[0] - 0.1).abs() < 1e-6 && (inv.r[1] - 0.5).abs() < 1e-6, "{:?}", inv.r);
+        // p̂₁ = −1/(2·1), p̂₂ = −2/(4·2)
+        assert!((inv.q[0] + 0.5).abs() < 1e-6 && (inv.q[1] + 0.25).abs() < 1e-6, "{:?}", inv.q);
+        assert!(PrandtlIshlinskii::new(0.0, 0.0, [0.3], [2.0], 1e-3).unwrap().inverse().is_err());
+    }
+
+    /// inverse(model(x)) = x on major and minor loops, from a non-relaxed start.
+    #[test]
+    fn inverse_round_trip() {
+        // Seed 004 Table A7's radii (unsorted, one zero) with non-degenerate weights, and
+        // a set with repeated radii.
+        let a7 = PrandtlIshlinskii::new(
+            0.3223,
+            0.1062,
+            [0.7709, 0.0455, 0.9998, 0.0, 0.7509],
+            [0.2, 0.6034, 0.1, 0.3, 0.05],
+            1e-3,
+        );
+        let ties = PrandtlIshlinskii::new(0.1, -0.2, [0.2, 0.05, 0.2, 0.05, 0.4], [0.5, 0.2, 0.3, 0.1, 1.0], 1e-3);
+        for m in [a7.unwrap(), ties.unwrap()] {
+            round_trip(&m);
+        }
+    }
+
+    fn round_trip(m: &PrandtlIshlinskii<5>) {
+        let inv = m.inverse().unwrap();
+        let x = |i: usize| {
+            let t = i as f32 / 500.0;
+            0.5 + 0.45 * (6.0 * t).sin() + 0.2 * (17.0 * t).cos() * (1.3 * t).sin()
+        };
+        let mut s = m.initial_state(&kin(x(0)));
+        let mut si = inv.state_from(&s);
+        let mut worst = 0.0f32;
+        for i in 0..5000 {
+            let y = m.step(&mut s, &kin(x(i)));
+            let xh = inv.step(&mut si, y);
+            worst = worst.max((xh - x(i)).abs());
+        }
+        assert!(worst < 2e-5, "round-trip error {worst}");
+        // And the reverse composition: model(inverse(y)) = y.
+        let mut s = m.initial_state(&kin(0.0));
+        let mut si = inv.state_from(&s);
+        let mut worst = 0.0f32;
+        for i in 0..3000 {
+            let yd = 0.2 + 0.15 * (i as f32 / 90.0).sin();
+            let xc = inv.step(&mut si, yd);
+            let y = m.step(&mut s, &kin(xc));
+            worst = worst.max((y - yd).abs());
+        }
+        assert!(worst < 2e-5, "model(inverse) error {worst}");
+    }
+
+    #[test]
+    fn rejects_bad_params() {
+        assert!(PrandtlIshlinskii::new(0.1, 0.0, [-0.1], [1.0], 1e-3).is_err());
+        assert!(PrandtlIshlinskii::new(0.1, 0.0, [0.1], [-1.0], 1e-3).is_err());
+        assert!(PrandtlIshlinskii::new(-0.1, 0.0, [0.1], [1.0], 1e-3).is_err());
+        assert!(PrandtlIshlinskii::new(0.1, f32::NAN, [0.1], [1.0], 1e-3).is_err());
+        assert!(PrandtlIshlinskii::<0>::new(0.1, 0.0, [], [], 1e-3).is_err());
+        assert!(PrandtlIshlinskii::<2>::from_params(&[0.1, 0.0, 0.1, 0.2, 1.0], 1e-3).is_err());
+        let m = PrandtlIshlinskii::<2>::from_params(&[0.1, 0.0, 0.1, 0.2, 1.0, 2.0], 1e-3).unwrap();
+        let mut out = [0.0; 6];
+        assert_eq!(m.write_params(&mut out), 6);
+        assert_eq!(out, [0.1, 0.0, 0.1, 0.2, 1.0, 2.0]);
     }
 }

@@ -1,26 +1,482 @@
-//! PLACEHOLDER — to be replaced by the real `preisach` model.
-use crate::{Kin, Model, ParamError};
+//! Discrete Preisach model, seed 004 eq. 5–9 (de la Morena et al. 2025):
+//!
+//! `Φ[x] = y₀ + s·Σ_{i=1..N} Σ_{j=1..i} p(H_M, H_C)·H_{αᵢ,βⱼ}[x]`  (eq. 9, with an output
+//! scale `s`; `s = 1` is the paper's model)
+//!
+//! with delayed relays (eq. 5) `H = 1` for `x ≥ α`, `0` for `x ≤ β`, unchanged between,
+//! and a density that is the product of two distributions in the Preisach-plane
+//! coordinates `H_M = (α+β)/2` (bias) and `H_C = (α−β)/2` (half-width), eq. 6:
+//! `p(α, β) = p_M(H_M)·p_C(H_C)`, with `p_M` Gaussian (eq. 7) and `p_C` Gaussian or
+//! Cauchy (eq. 8) — seed 004's "GG" and "GC" models (Tables A1–A6).
+//!
+//! **Grid.** The thresholds are `N` equally spaced values over the input range
+//! (`uᵢ = (i − ½)/N` of the normalised input `u = (x − x_min)/(x_max − x_min)`, a
+//! resolution of `1/N` as in the paper's "50 operators … resolution of 0.02"), and every
+//! pair `αᵢ ≥ βⱼ` (`j ≤ i`) carries one relay: `N(N+1)/2` relays. The densities are
+//! evaluated in normalised coordinates, exactly as seed 004 fits them on data
+//! normalised to 0…1, so Tables A1–A6 apply with `x_min = 0, x_max = 1, s = 1`. As in
+//! the paper the weights are the density values themselves (no cell-area factor), so
+//! they scale with `N`; the paper fits each `N` separately.
+//!
+//! **State.** The relays of one row `αᵢ` that are on always form a prefix
+//! `β₁ … β_{mᵢ}` (a relay with a lower β is switched off only by a lower input), so the
+//! relay states are stored exactly as one count `mᵢ ∈ 0..=i` per row (`[u8; N]`).
+//! The weights' prefix sums are precomputed in `new`; a step is `O(N)` with no
+//! transcendental function.
+//!
+//! **Initial state.** [`Model::initial_state`] is negative saturation — every relay off,
+//! the paper's `H[x(0)] = 0` — after which the first sample switches on every relay
+//! with `α ≤ x(0)` (so, as the paper notes, no initial loading curve from a
+//! demagnetised state). [`Preisach::demagnetised_state`] gives the AC-demagnetised
+//! staircase (relays with `H_M` below the range centre on) for callers that want it.
 
+use crate::error::{check, count, finite, time_step};
+use crate::math::{exp, sqrt};
+use crate::model::write_flat;
+use crate::{Finite, Kin, Model, ParamError};
+
+/// Largest grid size (row counts are stored as `u8`).
+pub const MAX_GRID: usize = 255;
+
+/// Which distribution `p_C(H_C)` is (`p_M(H_M)` is always Gaussian).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Density {
+    /// Gaussian–Gaussian ("GG", flat value 0).
+    GaussGauss,
+    /// Gaussian–Cauchy ("GC", flat value 1).
+    GaussCauchy,
+}
+
+impl Density {
+    fn from_code(v: f32) -> Result<Self, ParamError> {
+        if v == 0.0 {
+            Ok(Self::GaussGauss)
+        } else if v == 1.0 {
+            Ok(Self::GaussCauchy)
+        } else {
+            check("density", v, 0.0, 1.0)?;
+            Err(ParamError::Constraint { what: "density must be 0 (Gauss-Gauss) or 1 (Gauss-Cauchy)" })
+        }
+    }
+    fn code(self) -> f32 {
+        match self {
+            Self::GaussGauss => 0.0,
+            Self::GaussCauchy => 1.0,
+        }
+    }
+}
+
+/// Gaussian density, eq. 7 (f32 maths of crate::math, result widened for summing).
+fn gauss(k: f64, mu: f64, sigma: f64) -> f64 {
+    let d = ((k - mu) / sigma) as f32;
+    let norm = sqrt(2.0 * core::f32::consts::PI) as f64 * sigma;
+    f64::from(exp(-0.5 * d * d)) / norm
+}
+
+/// Cauchy density, eq. 8.
+fn cauchy(k: f64, mu: f64, sigma: f64) -> f64 {
+    let d = (k - mu) / sigma;
+    1.0 / (core::f64::consts::PI * sigma * (1.0 + d * d))
+}
+
+/// Coefficients of eq. 9 on an `N × N` threshold grid.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Placeholder;
-pub type State = ();
-pub type Registered = Placeholder;
+pub struct Preisach<const N: usize> {
+    /// σ of p_M(H_M) (> 0, normalised input units).
+    pub sigma_hm: f32,
+    /// μ of p_M(H_M) (normalised input units).
+    pub mu_hm: f32,
+    /// σ of p_C(H_C) (> 0).
+    pub sigma_hc: f32,
+    /// μ of p_C(H_C).
+    pub mu_hc: f32,
+    /// Output offset y₀ (output units).
+    pub y0: f32,
+    /// Output scale s (output units per unit weight); 1 in seed 004.
+    pub scale: f32,
+    /// Input range mapped to the normalised 0…1 of the grid (unit of x).
+    pub x_min: f32,
+    pub x_max: f32,
+    pub density: Density,
+    /// Thresholds αᵢ = βᵢ in the unit of x, ascending.
+    thresholds: [f32; N],
+    /// `cum[i][j] = s·Σ_{l ≤ j} p(αᵢ, β_l)` for `j ≤ i` (output units).
+    cum: [[f32; N]; N],
+    dt: f32,
+}
 
-impl Model for Placeholder {
-    type State = ();
+/// Relay states: `on[i]` relays of row `αᵢ` are on, namely those with `β₁ … β_{on[i]}`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct State<const N: usize> {
+    pub on: [u8; N],
+}
+
+impl<const N: usize> Default for State<N> {
+    /// Negative saturation: every relay off.
+    fn default() -> Self {
+        Self { on: [0; N] }
+    }
+}
+
+impl<const N: usize> Finite for State<N> {
+    fn is_finite(&self) -> bool {
+        true
+    }
+}
+
+impl<const N: usize> State<N> {
+    /// Whether the counts describe a reachable Preisach staircase: `on[i] ≤ i + 1`, and a
+    /// relay `(αᵢ, βⱼ)` that is on implies `(α_l, βⱼ)` on for every `l < i` with `j ≤ l`.
+    pub fn is_valid(&self) -> bool {
+        let mut ok = true;
+        let mut need = 0usize; // max over later rows of on[l], restricted below
+        for (i, &m) in self.on.iter().enumerate().rev() {
+            let m = usize::from(m);
+            ok &= m <= i + 1;
+            ok &= m >= need.min(i + 1);
+            need = need.max(m);
+        }
+        ok
+    }
+}
+
+/// Seed 004 finds 50 thresholds the point beyond which the fit stops improving
+/// (Tables A2, A5); 50 is the registered size (1275 relays, 10 KB of weights).
+pub type Registered = Preisach<50>;
+
+impl<const N: usize> Preisach<N> {
+    /// Paper form (Tables A1–A6 order) plus output scale and input range.
+    /// `σ_HM, σ_HC > 0`, every value finite, `x_min < x_max`, `1 ≤ N ≤ 255`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        density: Density,
+        sigma_hm: f32,
+        mu_hm: f32,
+        sigma_hc: f32,
+        mu_hc: f32,
+        y0: f32,
+        scale: f32,
+        x_min: f32,
+        x_max: f32,
+        dt: f32,
+    ) -> Result<Self, ParamError> {
+        if N == 0 || N > MAX_GRID {
+            return Err(ParamError::Constraint { what: "Preisach grid size must be 1..=255" });
+        }
+        let sigma_hm = check("sigma_hm", sigma_hm, f32::MIN_POSITIVE, f32::MAX)?;
+        let mu_hm = finite("mu_hm", mu_hm)?;
+        let sigma_hc = check("sigma_hc", sigma_hc, f32::MIN_POSITIVE, f32::MAX)?;
+        let mu_hc = finite("mu_hc", mu_hc)?;
+        let y0 = finite("y0", y0)?;
+        let scale = finite("scale", scale)?;
+        let x_min = finite("x_min", x_min)?;
+        let x_max = finite("x_max", x_max)?;
+        let span = x_max - x_min;
+        if !(span > 0.0 && span.is_finite()) {
+            return Err(ParamError::Constraint { what: "x_min < x_max (finite span)" });
+        }
+        let dt = time_step(dt)?;
+
+        let n = N as f64;
+        let u = |i: usize| (i as f64 + 0.5) / n;
+        let mut thresholds = [0.0f32; N];
+        for (i, t) in thresholds.iter_mut().enumerate() {
+            *t = (f64::from(x_min) + f64::from(span) * u(i)) as f32;
+        }
+        let (sm, mm, sc, mc) = (f64::from(sigma_hm), f64::from(mu_hm), f64::from(sigma_hc), f64::from(mu_hc));
+        let mut cum = [[0.0f32; N]; N];
+        for (i, row) in cum.iter_mut().enumerate() {
+            let mut acc = 0.0f64;
+            for (j, c) in row.iter_mut().enumerate().take(i + 1) {
+                let hm = 0.5 * (u(i) + u(j));
+                let hc = 0.5 * (u(i) - u(j));
+                let pc = match density {
+                    Density::GaussGauss => gauss(hc, mc, sc),
+                    Density::GaussCauchy => cauchy(hc, mc, sc),
+                };
+                acc += gauss(hm, mm, sm) * pc;
+                *c = (f64::from(scale) * acc) as f32;
+            }
+            if !row.is_finite() {
+                return Err(ParamError::Constraint {
+                    what: "Preisach weights overflow (sigma too small or scale too large)",
+                });
+            }
+        }
+        // The output must stay finite with every relay on.
+        let total: f32 = cum.iter().enumerate().filter_map(|(i, row)| row.get(i)).sum();
+        if !(y0 + total).is_finite() {
+            return Err(ParamError::Constraint { what: "Preisach output overflows" });
+        }
+        Ok(Self { sigma_hm, mu_hm, sigma_hc, mu_hc, y0, scale, x_min, x_max, density, thresholds, cum, dt })
+    }
+
+    /// Thresholds `αᵢ = βᵢ` in the unit of x, ascending.
+    pub fn thresholds(&self) -> &[f32; N] {
+        &self.thresholds
+    }
+
+    /// Weight of relay `(αᵢ, βⱼ)` times the scale (`None` unless `j ≤ i < N`).
+    pub fn weight(&self, i: usize, j: usize) -> Option<f32> {
+        if j > i {
+            return None;
+        }
+        let row = self.cum.get(i)?;
+        let c = *row.get(j)?;
+        Some(match j.checked_sub(1) {
+            Some(jm) => c - row.get(jm).copied().unwrap_or(0.0),
+            None => c,
+        })
+    }
+
+    /// AC-demagnetised state: relays with `αᵢ + βⱼ < x_min + x_max` (bias below the centre
+    /// of the range) on, the rest off.
+    pub fn demagnetised_state(&self) -> State<N> {
+        let mut s = State::default();
+        let centre2 = self.x_min + self.x_max;
+        for (i, (m, a)) in s.on.iter_mut().zip(self.thresholds).enumerate() {
+            let cnt = self.thresholds.iter().take(i + 1).filter(|&&b| a + b < centre2).count();
+            *m = cnt as u8;
+        }
+        s
+    }
+
+    /// Model output for a relay state (eq. 9).
+    #[inline]
+    pub fn output(&self, s: &State<N>) -> f32 {
+        let sum: f32 =
+            s.on.iter()
+                .zip(self.cum.iter())
+                .map(|(&m, row)| usize::from(m).checked_sub(1).and_then(|j| row.get(j)).copied().unwrap_or(0.0))
+                .sum();
+        self.y0 + sum
+    }
+}
+
+impl<const N: usize> Model for Preisach<N> {
+    type State = State<N>;
     const ID: &'static str = "preisach";
-    const PARAM_NAMES: &'static [&'static str] = &[];
-    const N_PARAMS: usize = 0;
-    fn from_params(_v: &[f32], _dt: f32) -> Result<Self, ParamError> {
-        Ok(Self)
+    const PARAM_NAMES: &'static [&'static str] =
+        &["sigma_hm", "mu_hm", "sigma_hc", "mu_hc", "y0", "scale", "x_min", "x_max", "density"];
+    const N_PARAMS: usize = 9;
+
+    fn from_params(v: &[f32], dt: f32) -> Result<Self, ParamError> {
+        count(v, Self::N_PARAMS)?;
+        match *v {
+            [s_hm, m_hm, s_hc, m_hc, y0, scale, x_min, x_max, d] => {
+                Self::new(Density::from_code(d)?, s_hm, m_hm, s_hc, m_hc, y0, scale, x_min, x_max, dt)
+            }
+            _ => Err(ParamError::WrongCount { expected: Self::N_PARAMS, got: v.len() }),
+        }
     }
-    fn write_params(&self, _out: &mut [f32]) -> usize {
-        0
+
+    fn write_params(&self, out: &mut [f32]) -> usize {
+        write_flat(
+            &[
+                self.sigma_hm,
+                self.mu_hm,
+                self.sigma_hc,
+                self.mu_hc,
+                self.y0,
+                self.scale,
+                self.x_min,
+                self.x_max,
+                self.density.code(),
+            ],
+            out,
+        )
     }
+
     fn dt(&self) -> f32 {
-        1.0
+        self.dt
     }
-    fn step(&self, _s: &mut (), _k: &Kin) -> f32 {
-        0.0
+
+    /// Negative saturation (every relay off), seed 004's `H[x(0)] = 0`.
+    fn initial_state(&self, _first: &Kin) -> State<N> {
+        State::default()
+    }
+
+    #[inline]
+    fn step(&self, s: &mut State<N>, k: &Kin) -> f32 {
+        let x = k.x;
+        // Rows with α ≤ x switch fully on; in the other rows every relay with β ≥ x
+        // switches off, i.e. at most the `below` relays with β < x stay on.
+        let at_or_below = self.thresholds.partition_point(|&a| a <= x);
+        let below = self.thresholds.partition_point(|&b| b < x);
+        let below = u8::try_from(below).unwrap_or(u8::MAX);
+        for (i, m) in s.on.iter_mut().enumerate() {
+            if i < at_or_below {
+                *m = u8::try_from(i + 1).unwrap_or(u8::MAX);
+            } else {
+                *m = (*m).min(below);
+            }
+        }
+        self.output(s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+    use super::*;
+
+    fn kin(x: f32) -> Kin {
+        Kin::new(x, 0.0, 0.0, 0.0)
+    }
+
+    /// Seed 004 Table A2 (GC-50).
+    fn gc50() -> Preisach<50> {
+        Preisach::new(Density::GaussCauchy, 3.2352, 11.6040, 0.0232, 0.0001, 0.0837, 1.0, 0.0, 1.0, 1e-3).unwrap()
+    }
+
+    /// Eq. 9 by hand for a 2 × 2 grid: thresholds 0.25 and 0.75, relays
+    /// (0.25, 0.25), (0.75, 0.25), (0.75, 0.75).
+    #[test]
+    fn matches_eq9_by_hand() {
+        let (sm, mm, sc, mc, y0, s) = (0.3f64, 0.4f64, 0.2f64, 0.1f64, 0.05f64, 2.0f64);
+        let g = |k: f64, mu: f64, sg: f64| {
+            (-(k - mu) * (k - mu) / (2.0 * sg * sg)).exp() / ((2.0 * std::f64::consts::PI).sqrt() * sg)
+        };
+        let c = |k: f64, mu: f64, sg: f64| 1.0 / (std::f64::consts::PI * sg * (1.0 + ((k - mu) / sg).powi(2)));
+        for density in [Density::GaussGauss, Density::GaussCauchy] {
+            let pc = |hc: f64| if density == Density::GaussGauss { g(hc, mc, sc) } else { c(hc, mc, sc) };
+            let w11 = g(0.25, mm, sm) * pc(0.0);
+            let w21 = g(0.5, mm, sm) * pc(0.25);
+            let w22 = g(0.75, mm, sm) * pc(0.0);
+            let m = Preisach::<2>::new(density, 0.3, 0.4, 0.2, 0.1, 0.05, 2.0, 0.0, 1.0, 1e-3).unwrap();
+            assert_eq!(m.thresholds(), &[0.25, 0.75]);
+            let mut st = m.initial_state(&kin(0.0));
+            let seq = [
+                (0.0, 0.0),
+                (0.5, w11),
+                (1.0, w11 + w21 + w22),
+                (0.5, w11 + w21),
+                (0.2, 0.0),
+                (0.8, w11 + w21 + w22),
+                (0.25, w11),
+            ];
+            for (x, w) in seq {
+                let y = f64::from(m.step(&mut st, &kin(x)));
+                let want = y0 + s * w;
+                assert!((y - want).abs() < 1e-5 * want.abs().max(1.0), "{density:?} x={x}: {y} vs {want}");
+                assert!(st.is_valid());
+            }
+        }
+    }
+
+    #[test]
+    fn range_mapping_and_weights() {
+        let m = Preisach::<4>::new(Density::GaussGauss, 0.5, 0.5, 0.1, 0.0, 0.0, 1.0, 100.0, 300.0, 1e-3).unwrap();
+        assert_eq!(m.thresholds(), &[125.0, 175.0, 225.0, 275.0]);
+        assert!(m.weight(1, 2).is_none() && m.weight(4, 0).is_none());
+        // Relay (α₄, β₁) = (0.875, 0.125) normalised: H_M = 0.5, H_C = 0.375.
+        let g = |k: f64, mu: f64, sg: f64| {
+            (-(k - mu) * (k - mu) / (2.0 * sg * sg)).exp() / ((2.0 * std::f64::consts::PI).sqrt() * sg)
+        };
+        let want = g(0.5, 0.5, 0.5) * g(0.375, 0.0, 0.1);
+        let got = f64::from(m.weight(3, 0).unwrap());
+        assert!((got - want).abs() < 1e-5 * want, "{got} vs {want}");
+    }
+
+    /// Run `xs` (each value reached by a straight ramp of small steps) and return the
+    /// final state and the outputs at every sample.
+    fn run(m: &Preisach<50>, s: &mut State<50>, xs: &[f32]) -> Vec<f32> {
+        let mut out = Vec::new();
+        let mut x0 = xs[0];
+        for &x1 in xs {
+            for k in 1..=40 {
+                let x = x0 + (x1 - x0) * k as f32 / 40.0;
+                out.push(m.step(s, &kin(x)));
+            }
+            x0 = x1;
+        }
+        out
+    }
+
+    /// Wiping-out: once the input passes a dominant maximum and then a dominant minimum,
+    /// the smaller extrema in between are forgotten; two histories sharing those last
+    /// dominant extrema give identical outputs from then on.
+    #[test]
+    fn wiping_out_property() {
+        let m = gc50();
+        let mut a = m.initial_state(&kin(0.0));
+        let mut b = m.initial_state(&kin(0.0));
+        // Different inner histories, same dominant max 0.85 and dominant min 0.12.
+        run(&m, &mut a, &[0.0, 0.6, 0.3, 0.85, 0.4, 0.7, 0.5, 0.12]);
+        run(&m, &mut b, &[0.0, 0.85, 0.2, 0.8, 0.35, 0.6, 0.15, 0.12]);
+        assert_eq!(a, b, "memory of the smaller extrema was not wiped out");
+        let cont = [0.12, 0.55, 0.3, 0.72, 0.05, 0.9];
+        let ya = run(&m, &mut a, &cont);
+        let yb = run(&m, &mut b, &cont);
+        assert_eq!(ya, yb);
+        // Control: a history with a different dominant maximum does not coincide.
+        let mut c = m.initial_state(&kin(0.0));
+        run(&m, &mut c, &[0.0, 0.95, 0.4, 0.12]);
+        assert_ne!(a, c);
+        let yc = run(&m, &mut c, &cont);
+        assert!(ya.iter().zip(&yc).any(|(p, q)| (p - q).abs() > 1e-4));
+    }
+
+    /// Congruency: minor loops between the same two input extrema are congruent (equal up
+    /// to a vertical shift) whatever the history before them.
+    #[test]
+    fn congruency_property() {
+        let m = gc50();
+        let (lo, hi) = (0.3f32, 0.62f32);
+        let loops: Vec<Vec<f32>> = [vec![0.0, 1.0, lo], vec![0.0, 0.7, 0.05, 0.66, lo], vec![0.0, 0.9, 0.1, hi, lo]]
+            .iter()
+            .map(|hist| {
+                let mut s = m.initial_state(&kin(0.0));
+                run(&m, &mut s, hist);
+                // One cycle lo → hi → lo to settle, then record the next.
+                run(&m, &mut s, &[lo, hi, lo]);
+                run(&m, &mut s, &[lo, hi, lo])
+            })
+            .collect();
+        let mut shifts = Vec::new();
+        for other in &loops[1..] {
+            let d: Vec<f32> = loops[0].iter().zip(other).map(|(p, q)| q - p).collect();
+            let spread = d.iter().cloned().fold(f32::MIN, f32::max) - d.iter().cloned().fold(f32::MAX, f32::min);
+            assert!(spread < 1e-4, "minor loops not congruent: spread {spread}");
+            shifts.push(d[0]);
+        }
+        // The histories do put the loops at different heights (the test is not vacuous).
+        assert!(shifts.iter().all(|s| s.abs() > 1e-3), "shifts {shifts:?}");
+        // And the minor loop is a loop: rising and falling branches differ mid-way.
+        let l = &loops[0];
+        let n = l.len();
+        assert!((l[n / 4] - l[3 * n / 4]).abs() > 1e-3);
+    }
+
+    #[test]
+    fn state_validity_and_demagnetised() {
+        let m = Preisach::<8>::new(Density::GaussGauss, 1.0, 0.5, 0.2, 0.0, 0.0, 1.0, 0.0, 1.0, 1e-3).unwrap();
+        let d = m.demagnetised_state();
+        assert!(d.is_valid());
+        // Row i: thresholds (i+½)/8, relays with αᵢ + βⱼ < 1 → j < 7 − i.
+        assert_eq!(d.on, [1, 2, 3, 4, 3, 2, 1, 0]);
+        assert!(!State { on: [0, 0, 0, 0, 0, 0, 0, 2] }.is_valid());
+        assert!(!State { on: [2, 0, 0, 0, 0, 0, 0, 0] }.is_valid());
+        assert!(State { on: [1, 2, 2, 2, 1, 1, 1, 0] }.is_valid());
+    }
+
+    #[test]
+    fn rejects_bad_params() {
+        let ok = [3.2, 11.6, 0.023, 0.0, 0.08, 1.0, 0.0, 1.0, 1.0];
+        let m = Preisach::<10>::from_params(&ok, 1e-3).unwrap();
+        let mut out = [0.0; 9];
+        assert_eq!(m.write_params(&mut out), 9);
+        assert_eq!(out, ok);
+        for (i, v) in [(0, 0.0), (2, -1.0), (7, 0.0), (8, 2.0), (8, 0.5), (4, f32::NAN), (5, f32::INFINITY)] {
+            let mut bad = ok;
+            bad[i] = v;
+            assert!(Preisach::<10>::from_params(&bad, 1e-3).is_err(), "index {i} = {v}");
+        }
+        // Tiny σ_HC makes the Cauchy peak overflow f32 once scaled.
+        let mut huge = ok;
+        huge[5] = 1e30;
+        huge[2] = 1e-30;
+        assert!(Preisach::<10>::from_params(&huge, 1e-3).is_err());
+        assert!(Preisach::<10>::from_params(&ok[..8], 1e-3).is_err());
     }
 }
