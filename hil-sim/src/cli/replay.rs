@@ -23,10 +23,11 @@ pub struct ReplayArgs {
 }
 
 pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
+    let rate = a.ch.rate()?;
     let pf = ParamsFile::read(&a.params)?;
     let flat = pf.flat(&a.params)?;
     let rec = Recording::read_csv(&super::file_arg(&a.rec)?)?;
-    let r = replay_recording(&rec, &a.ch.channels(), &pf.model, &flat, a.ch.rate()?)
+    let r = replay_recording(&rec, &a.ch.channels(), &pf.model, &flat, rate)
         .with_context(|| format!("replaying {}", a.rec.display()))?;
     if a.json {
         return super::print_json(&json!({

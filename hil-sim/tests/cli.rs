@@ -1,0 +1,70 @@
+//! The command-line contract (shared/spec/cli-contract.md), exercised on the binary.
+
+use std::process::Command;
+
+fn hil_sim(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_hil-sim")).args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+const IDS: [&str; 17] = [
+    "algebraic", "bouc_wen", "lugre", "tanh", "hammerstein_wiener", "narx", "bingham", "spencer",
+    "dahl", "arctan", "arctan_inertia", "trig", "preisach", "prandtl_ishlinskii", "gpi",
+    "maxwell_slip", "bouc_wen_asym",
+];
+
+#[test]
+fn models_json_lists_all_17_with_contract_fields() {
+    let (code, out, _) = hil_sim(&["models", "--json"]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&out).expect("stdout is one JSON object");
+    let models = v["models"].as_array().unwrap();
+    let ids: Vec<&str> = models.iter().map(|m| m["id"].as_str().unwrap()).collect();
+    assert_eq!(ids, IDS);
+    for m in models {
+        let params = m["params"].as_array().unwrap();
+        assert!(!params.is_empty(), "{} has no parameter names", m["id"]);
+        assert!(params.iter().all(|p| p.as_str().is_some_and(|s| !s.is_empty())));
+        assert_eq!(m["no_std"], true);
+        assert!(m["state_bytes"].as_u64().is_some());
+        assert!(m["n_params"].as_u64().unwrap() >= params.len() as u64);
+    }
+}
+
+#[test]
+fn errors_are_one_line_and_nonzero() {
+    let dir = std::env::temp_dir().join(format!("hil-sim-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let params = dir.join("p.json");
+    std::fs::write(&params, r#"{"model":"algebraic","params":{"k":1,"c":0,"alpha":0,"t0":0}}"#).unwrap();
+    let bad_params = dir.join("bad.json");
+    std::fs::write(&bad_params, r#"{"model":"algebraic","params":{"k":1}}"#).unwrap();
+    let rec = dir.join("r.csv");
+    std::fs::write(&rec, "t,b,torque\n0,0,0\n0.001,0.1,0.1\n0.002,x,0.2\n").unwrap();
+    let (p, b, r) = (params.to_str().unwrap(), bad_params.to_str().unwrap(), rec.to_str().unwrap());
+    for (args, needle) in [
+        (vec!["replay", r, "--params", p], "r.csv:4"),
+        (vec!["replay", "/nonexistent.csv", "--params", p], "no such file"),
+        (vec!["replay", r, "--params", b], "missing parameter `c`"),
+        (vec!["replay", r, "--params", p, "--rate", "fast"], "--rate fast"),
+        (vec!["accuracy", "--model", "nope"], "unknown model `nope`"),
+    ] {
+        let (code, out, err) = hil_sim(&args);
+        assert_ne!(code, 0, "{args:?}");
+        assert!(out.is_empty(), "{args:?} printed on stdout: {out}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+    // A good replay with --json prints exactly one object with metrics.
+    std::fs::write(&rec, "t,b,torque\n0,0,0\n0.001,0.1,0.1\n0.002,0.2,0.2\n0.003,0.3,0.3\n").unwrap();
+    let (code, out, _) = hil_sim(&["replay", r, "--params", p, "--json"]);
+    assert_eq!(code, 0);
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(v["metrics"]["rmse"].as_f64().unwrap() < 1e-6);
+    assert!(v["metrics"]["r2"].as_f64().unwrap() > 0.999_999);
+}
