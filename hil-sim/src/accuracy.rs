@@ -186,8 +186,11 @@ pub fn dyke(case: &Case, rec: &Recording) -> Result<Row, String> {
         dt,
         |k| Input { x: xf[k], dx: if k > 0 { slope(k) } else { 0.0 }, ddx: 0.0, u: uf[k] },
         |k, t| {
-            let t0 = (k - 1) as f64 * dt;
-            Input { x: xf[k - 1] + slope(k) * (t - t0), dx: slope(k), ddx: 0.0, u: uf[k] }
+            // Input and command linear between samples: the f32 core's η filter is exact
+            // for a command of that shape, and its rate is the backward difference.
+            let s = (t - (k - 1) as f64 * dt) / dt;
+            let u = uf[k - 1] + (uf[k] - uf[k - 1]) * s;
+            Input { x: xf[k - 1] + slope(k) * s * dt, dx: slope(k), ddx: 0.0, u }
         },
     )?;
     let name = format!(
