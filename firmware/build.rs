@@ -16,10 +16,8 @@ fn main() {
     }
 
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
-    let manifest =
-        PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
-    fs::copy(manifest.join("../memory.x"), out.join("memory.x"))
-        .expect("copy ../memory.x into OUT_DIR");
+    let manifest = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets CARGO_MANIFEST_DIR"));
+    fs::copy(manifest.join("../memory.x"), out.join("memory.x")).expect("copy ../memory.x into OUT_DIR");
     println!("cargo:rustc-link-search={}", out.display());
 
     println!("cargo:rustc-link-arg-bins=--nmagic");

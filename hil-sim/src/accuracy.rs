@@ -193,11 +193,15 @@ pub fn synthetic(case: &Case, exc: &Excitation, fs: f64, duration: f64) -> Resul
         .map(|k| {
             let i = input_at(k as f64 * dt);
             let s = Sample { x: i.x as f32, u: None, dx: Some(i.dx as f32), ddx: Some(i.ddx as f32) };
-            if matches!(case.command, Command::Constant(_)) { s.with_command(u as f32) } else { s }
+            if matches!(case.command, Command::Constant(_)) {
+                s.with_command(u as f32)
+            } else {
+                s
+            }
         })
         .collect();
-    let core = replay(case.model, &case.params, dt as f32, RateChoice::Backward, &samples)
-        .map_err(|e| e.to_string())?;
+    let core =
+        replay(case.model, &case.params, dt as f32, RateChoice::Backward, &samples).map_err(|e| e.to_string())?;
     let r = dense_outputs(case.reference.as_ref(), n, dt, input_at)?;
     Ok(compare(case, exc.name(), fs, &core.y, core.held, &r))
 }
@@ -209,10 +213,9 @@ pub fn dyke(case: &Case, rec: &Recording) -> Result<Row, String> {
     let u = rec.channel("Y").map_err(|e| e.to_string())?;
     let dt = rec.mean_dt("t").map_err(|e| e.to_string())?;
     let n = x.len();
-    let samples: Vec<Sample> =
-        x.iter().zip(u).map(|(x, u)| Sample::new(*x as f32).with_command(*u as f32)).collect();
-    let core = replay(case.model, &case.params, dt as f32, RateChoice::Backward, &samples)
-        .map_err(|e| e.to_string())?;
+    let samples: Vec<Sample> = x.iter().zip(u).map(|(x, u)| Sample::new(*x as f32).with_command(*u as f32)).collect();
+    let core =
+        replay(case.model, &case.params, dt as f32, RateChoice::Backward, &samples).map_err(|e| e.to_string())?;
     // The f32 core sees x and u in f32: give the reference the same rounded values.
     let xf: Vec<f64> = x.iter().map(|v| f64::from(*v as f32)).collect();
     let uf: Vec<f64> = u.iter().map(|v| f64::from(*v as f32)).collect();
@@ -260,7 +263,9 @@ pub fn run_all(
 ) -> Result<Vec<Row>, String> {
     let cases: Vec<Case> =
         crate::reference::cases().into_iter().filter(|c| filter.is_none_or(|f| c.model == f)).collect();
-    let mut jobs: Vec<(usize, Option<(Excitation, f64, f64)>)> = Vec::new();
+    // (case index, synthetic excitation with duration and rate, or the recording)
+    type Job = (usize, Option<(Excitation, f64, f64)>);
+    let mut jobs: Vec<Job> = Vec::new();
     for (i, c) in cases.iter().enumerate() {
         for (e, d) in excitations(quick) {
             for fs in RATES_HZ {

@@ -26,8 +26,7 @@ pub fn shared_dir() -> Option<PathBuf> {
 /// A file under `shared/data/`, e.g. `dyke/ranran_50.csv`.
 pub fn data_file(rel: &str) -> Result<PathBuf, String> {
     let dir = shared_dir().ok_or_else(|| {
-        "cannot find the project's shared/ folder (expected beside the repository; set MRC_SHARED_DIR)"
-            .to_owned()
+        "cannot find the project's shared/ folder (expected beside the repository; set MRC_SHARED_DIR)".to_owned()
     })?;
     let p = dir.join("data").join(rel);
     if p.is_file() {

@@ -44,7 +44,10 @@ pub enum RateChoice {
     /// First-order filtered differentiator, cutoff in Hz.
     Filtered(f32),
     /// Seed 002's Kalman filter with jerk intensity `q` and measurement variance `r`.
-    Kalman { q: f32, r: f32 },
+    Kalman {
+        q: f32,
+        r: f32,
+    },
 }
 
 impl RateChoice {
@@ -99,13 +102,7 @@ impl Visit for Run<'_> {
 
 /// Run `samples` through model `id` with flat parameters `params`, one step per sample
 /// of `dt` seconds, in f32 — the code the firmware runs.
-pub fn replay(
-    id: &str,
-    params: &[f32],
-    dt: f32,
-    rate: RateChoice,
-    samples: &[Sample],
-) -> Result<Replay, ReplayError> {
+pub fn replay(id: &str, params: &[f32], dt: f32, rate: RateChoice, samples: &[Sample]) -> Result<Replay, ReplayError> {
     visit(id, Run { params, dt, rate, samples })
         .ok_or_else(|| ReplayError::UnknownModel(id.to_owned()))?
         .map_err(|source| ReplayError::Params { model: id.to_owned(), source })
@@ -135,10 +132,7 @@ mod tests {
         let s: Vec<Sample> = (0..4).map(|i| Sample::new(i as f32)).collect();
         let r = replay("algebraic", &[2.0, 0.0, 0.0, 1.0], 0.01, RateChoice::Backward, &s).unwrap();
         assert_eq!(r.y, vec![1.0, 3.0, 5.0, 7.0]);
-        assert!(matches!(
-            replay("nope", &[], 0.01, RateChoice::Backward, &s),
-            Err(ReplayError::UnknownModel(_))
-        ));
+        assert!(matches!(replay("nope", &[], 0.01, RateChoice::Backward, &s), Err(ReplayError::UnknownModel(_))));
         let e = replay("algebraic", &[1.0], 0.01, RateChoice::Backward, &s).unwrap_err();
         assert!(e.to_string().contains("expected 4 parameters"), "{e}");
     }

@@ -31,8 +31,7 @@ impl Excitation {
     pub fn seed000_multisine() -> Self {
         let n = 11;
         let f: Vec<f64> = (0..n).map(|i| 1.0 + 9.0 * i as f64 / (n - 1) as f64).collect();
-        let raw: Vec<f64> =
-            f.iter().enumerate().map(|(i, fi)| (1.0 + 0.35 * ((i * 7 % 5) as f64)) / fi).collect();
+        let raw: Vec<f64> = f.iter().enumerate().map(|(i, fi)| (1.0 + 0.35 * ((i * 7 % 5) as f64)) / fi).collect();
         let s: f64 = raw.iter().sum();
         Self::MultiSine { f, a: raw.iter().map(|v| v / s).collect() }
     }
@@ -103,11 +102,7 @@ mod tests {
     #[test]
     fn derivatives_match_finite_differences() {
         let h = 1e-6;
-        for e in [
-            Excitation::Sine { f: 3.0 },
-            Excitation::seed000_multisine(),
-            Excitation::seed000_swept(40.0),
-        ] {
+        for e in [Excitation::Sine { f: 3.0 }, Excitation::seed000_multisine(), Excitation::seed000_swept(40.0)] {
             for &t in &[0.1, 1.3, 7.77, 33.3] {
                 let (a, b, c) = (e.at(t - h), e.at(t), e.at(t + h));
                 let dx = (c.x - a.x) / (2.0 * h);
@@ -120,9 +115,7 @@ mod tests {
 
     #[test]
     fn unit_range_and_multisine_spec() {
-        let Excitation::MultiSine { f, a } = Excitation::seed000_multisine() else {
-            unreachable!()
-        };
+        let Excitation::MultiSine { f, a } = Excitation::seed000_multisine() else { unreachable!() };
         assert_eq!(f.len(), 11);
         assert!(f.iter().all(|v| (1.0..=10.0).contains(v)));
         assert!((a.iter().map(|v| v.abs()).sum::<f64>() - 1.0).abs() < 1e-12);

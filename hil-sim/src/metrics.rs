@@ -60,9 +60,7 @@ pub fn metrics(measured: &[f64], model: &[f64], rates: Option<(&[f64], &[f64])>)
         ratio(num, den).sqrt()
     };
     let (e_x, e_xdot) = match rates {
-        Some((dx, ddx)) if dx.len() >= n && ddx.len() >= n => {
-            (Some(weighted(&dx[..n])), Some(weighted(&ddx[..n])))
-        }
+        Some((dx, ddx)) if dx.len() >= n && ddx.len() >= n => (Some(weighted(&dx[..n])), Some(weighted(&ddx[..n]))),
         _ => (None, None),
     };
     let nrmse = ratio(sse, sst).sqrt();

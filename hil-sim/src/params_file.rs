@@ -62,22 +62,17 @@ pub fn block(name: &str) -> (&str, usize) {
 
 impl ParamsFile {
     pub fn read(path: &Path) -> Result<Self, ParamsFileError> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| ParamsFileError::Io { path: path.to_path_buf(), source })?;
-        serde_json::from_str(&text)
-            .map_err(|source| ParamsFileError::Json { path: path.to_path_buf(), source })
+        let text =
+            std::fs::read_to_string(path).map_err(|source| ParamsFileError::Io { path: path.to_path_buf(), source })?;
+        serde_json::from_str(&text).map_err(|source| ParamsFileError::Json { path: path.to_path_buf(), source })
     }
 
     /// The flat f32 vector in the model's parameter order.
     pub fn flat(&self, path: &Path) -> Result<Vec<f32>, ParamsFileError> {
-        let info = model_core::registry::find(&self.model).ok_or_else(|| {
-            ParamsFileError::UnknownModel { path: path.to_path_buf(), model: self.model.clone() }
-        })?;
-        let err = |reason: String| ParamsFileError::Params {
-            path: path.to_path_buf(),
-            model: self.model.clone(),
-            reason,
-        };
+        let info = model_core::registry::find(&self.model)
+            .ok_or_else(|| ParamsFileError::UnknownModel { path: path.to_path_buf(), model: self.model.clone() })?;
+        let err =
+            |reason: String| ParamsFileError::Params { path: path.to_path_buf(), model: self.model.clone(), reason };
         let flat: Vec<f64> = match &self.params {
             Values::Flat(v) => v.clone(),
             Values::Named(map) => {
@@ -90,18 +85,13 @@ impl ParamsFile {
                         (Some(Value::Block(v)), n) => {
                             return Err(err(format!("`{key}` needs {n} values, got {}", v.len())))
                         }
-                        (Some(Value::One(_)), n) => {
-                            return Err(err(format!("`{key}` needs an array of {n} values")))
-                        }
+                        (Some(Value::One(_)), n) => return Err(err(format!("`{key}` needs an array of {n} values"))),
                         (None, _) => return Err(err(format!("missing parameter `{key}`"))),
                     }
                 }
                 let known: Vec<&str> = info.params.iter().map(|n| block(n).0).collect();
                 if let Some(extra) = map.keys().find(|k| !known.contains(&k.as_str())) {
-                    return Err(err(format!(
-                        "unknown parameter `{extra}` (expected: {})",
-                        known.join(", ")
-                    )));
+                    return Err(err(format!("unknown parameter `{extra}` (expected: {})", known.join(", "))));
                 }
                 out
             }
@@ -136,23 +126,17 @@ mod tests {
     #[test]
     fn named_and_flat_and_errors() {
         let p = Path::new("p.json");
-        let f: ParamsFile = serde_json::from_str(
-            r#"{"model":"algebraic","params":{"k":1,"c":2,"alpha":3,"t0":4}}"#,
-        )
-        .unwrap();
+        let f: ParamsFile =
+            serde_json::from_str(r#"{"model":"algebraic","params":{"k":1,"c":2,"alpha":3,"t0":4}}"#).unwrap();
         assert_eq!(f.flat(p).unwrap(), vec![1.0, 2.0, 3.0, 4.0]);
         let back = ParamsFile::from_flat("algebraic", None, &[1.0, 2.0, 3.0, 4.0]).unwrap();
         assert_eq!(back.flat(p).unwrap(), vec![1.0, 2.0, 3.0, 4.0]);
-        let f: ParamsFile =
-            serde_json::from_str(r#"{"model":"algebraic","params":[1,2,3,4]}"#).unwrap();
+        let f: ParamsFile = serde_json::from_str(r#"{"model":"algebraic","params":[1,2,3,4]}"#).unwrap();
         assert_eq!(f.flat(p).unwrap().len(), 4);
-        let f: ParamsFile =
-            serde_json::from_str(r#"{"model":"algebraic","params":{"k":1,"c":2,"alpha":3}}"#).unwrap();
+        let f: ParamsFile = serde_json::from_str(r#"{"model":"algebraic","params":{"k":1,"c":2,"alpha":3}}"#).unwrap();
         assert!(f.flat(p).unwrap_err().to_string().contains("missing parameter `t0`"));
-        let f: ParamsFile = serde_json::from_str(
-            r#"{"model":"algebraic","params":{"k":1,"c":2,"alpha":3,"t0":4,"zz":1}}"#,
-        )
-        .unwrap();
+        let f: ParamsFile =
+            serde_json::from_str(r#"{"model":"algebraic","params":{"k":1,"c":2,"alpha":3,"t0":4,"zz":1}}"#).unwrap();
         assert!(f.flat(p).unwrap_err().to_string().contains("unknown parameter `zz`"));
         let f: ParamsFile = serde_json::from_str(r#"{"model":"nope","params":[]}"#).unwrap();
         assert!(f.flat(p).unwrap_err().to_string().contains("unknown model"));

@@ -56,8 +56,7 @@ fn parse_number(text: &str) -> Result<f64, ()> {
 impl Recording {
     /// Read a CSV recording.
     pub fn read_csv(path: &Path) -> Result<Self, RecordingError> {
-        let bytes = std::fs::read(path)
-            .map_err(|source| RecordingError::Io { path: path.to_path_buf(), source })?;
+        let bytes = std::fs::read(path).map_err(|source| RecordingError::Io { path: path.to_path_buf(), source })?;
         Self::parse_csv(path, &bytes)
     }
 
@@ -67,15 +66,10 @@ impl Recording {
         if bytes.iter().all(|b| b.is_ascii_whitespace()) {
             return Err(RecordingError::Empty { path: p() });
         }
-        let mut rdr = csv::ReaderBuilder::new()
-            .has_headers(true)
-            .flexible(true)
-            .trim(csv::Trim::All)
-            .from_reader(bytes);
-        let header = rdr
-            .headers()
-            .map_err(|e| RecordingError::Malformed { path: p(), line: 1, reason: e.to_string() })?
-            .clone();
+        let mut rdr =
+            csv::ReaderBuilder::new().has_headers(true).flexible(true).trim(csv::Trim::All).from_reader(bytes);
+        let header =
+            rdr.headers().map_err(|e| RecordingError::Malformed { path: p(), line: 1, reason: e.to_string() })?.clone();
         // A trailing comma gives a last, unnamed column: ignore unnamed columns that stay empty.
         let names: Vec<String> = header.iter().map(str::to_owned).collect();
         if names.iter().all(String::is_empty) {
@@ -128,12 +122,7 @@ impl Recording {
                     text: text.to_owned(),
                 })?;
                 if !v.is_finite() {
-                    return Err(RecordingError::NonFinite {
-                        path: p(),
-                        line,
-                        column: name,
-                        text: text.to_owned(),
-                    });
+                    return Err(RecordingError::NonFinite { path: p(), line, column: name, text: text.to_owned() });
                 }
                 col.push(Some(v));
             }

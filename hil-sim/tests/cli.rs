@@ -12,9 +12,23 @@ fn hil_sim(args: &[&str]) -> (i32, String, String) {
 }
 
 const IDS: [&str; 17] = [
-    "algebraic", "bouc_wen", "lugre", "tanh", "hammerstein_wiener", "narx", "bingham", "spencer",
-    "dahl", "arctan", "arctan_inertia", "trig", "preisach", "prandtl_ishlinskii", "gpi",
-    "maxwell_slip", "bouc_wen_asym",
+    "algebraic",
+    "bouc_wen",
+    "lugre",
+    "tanh",
+    "hammerstein_wiener",
+    "narx",
+    "bingham",
+    "spencer",
+    "dahl",
+    "arctan",
+    "arctan_inertia",
+    "trig",
+    "preisach",
+    "prandtl_ishlinskii",
+    "gpi",
+    "maxwell_slip",
+    "bouc_wen_asym",
 ];
 
 #[test]

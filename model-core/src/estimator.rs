@@ -84,12 +84,7 @@ impl<M: Model> Estimator<M> {
         }
         let saved = *s;
         let (edx, eddx) = self.rate.step(&mut s.rate, sample.x);
-        let k = Kin {
-            x: sample.x,
-            dx: sample.dx.unwrap_or(edx),
-            ddx: sample.ddx.unwrap_or(eddx),
-            u,
-        };
+        let k = Kin { x: sample.x, dx: sample.dx.unwrap_or(edx), ddx: sample.ddx.unwrap_or(eddx), u };
         if !k.is_finite() || !s.rate.is_finite() {
             *s = saved;
             return self.reject(s, Flags::OVERFLOW);
@@ -121,8 +116,7 @@ mod tests {
 
     fn est() -> Estimator<Algebraic> {
         let dt = 0.01;
-        Estimator::new(Algebraic::new(2.0, 0.5, 1.0, 0.0, dt).unwrap(), RateParams::backward(dt).unwrap())
-            .unwrap()
+        Estimator::new(Algebraic::new(2.0, 0.5, 1.0, 0.0, dt).unwrap(), RateParams::backward(dt).unwrap()).unwrap()
     }
 
     #[test]
@@ -141,7 +135,6 @@ mod tests {
             let o = e.step(&mut s, bad);
             assert_eq!(o.y, a.y);
             assert!(o.flags.contains(Flags::NON_FINITE_INPUT));
-            assert_eq!(s.model, before.model);
             assert_eq!(s.rate, before.rate);
         }
         assert_eq!(s.rejected, 4);
@@ -173,5 +166,25 @@ mod tests {
         e.step(&mut s, Sample::new(0.0));
         let o = e.step(&mut s, Sample::new(0.0).with_rate(4.0));
         assert!((o.y - 0.5 * 4.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn rejected_samples_leave_a_stateful_model_untouched() {
+        use crate::models::lugre::LuGre;
+        let dt = 1e-3;
+        let e =
+            Estimator::new(LuGre::new(5.0, 6.0, 0.01, -0.1, 4.0, 5.0, dt).unwrap(), RateParams::backward(dt).unwrap())
+                .unwrap();
+        let mut s = e.state();
+        for k in 0..50 {
+            e.step(&mut s, Sample::new(0.02 * k as f32));
+        }
+        let before = s;
+        assert_ne!(before.model, Default::default(), "the test needs a non-trivial state");
+        let o = e.step(&mut s, Sample::new(f32::NAN));
+        assert!(o.flags.contains(Flags::NON_FINITE_INPUT));
+        let o = e.step(&mut s, Sample::new(3e38));
+        assert!(o.flags.contains(Flags::OVERFLOW), "{o:?}");
+        assert_eq!((s.model, s.rate, s.last), (before.model, before.rate, before.last));
     }
 }

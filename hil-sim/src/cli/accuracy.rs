@@ -32,12 +32,14 @@ pub fn rows(a: &AccuracyArgs) -> anyhow::Result<Vec<Row>> {
     }
     let n = accuracy::count_jobs(a.model.as_deref(), a.quick, rec.is_some());
     if n == 0 {
-        anyhow::bail!("no accuracy cases for {}: it has no ODE (stateless or exact operator models need none)",
-            a.model.as_deref().unwrap_or("any model"));
+        anyhow::bail!(
+            "no accuracy cases for {}: it has no ODE (stateless or exact operator models need none)",
+            a.model.as_deref().unwrap_or("any model")
+        );
     }
     let pb = super::progress(n as u64, "accuracy");
-    let rows = accuracy::run_all(a.model.as_deref(), a.quick, rec.as_ref(), &|| pb.inc(1))
-        .map_err(anyhow::Error::msg)?;
+    let rows =
+        accuracy::run_all(a.model.as_deref(), a.quick, rec.as_ref(), &|| pb.inc(1)).map_err(anyhow::Error::msg)?;
     pb.finish_and_clear();
     Ok(rows)
 }
@@ -50,21 +52,34 @@ pub fn table(rows: &[Row]) -> String {
     for r in rows {
         s += &format!(
             "{:<14} {:<34} {:<34} {:>6.0} {:>8} {:>10.4} {:>11.3e}  {}\n",
-            r.model, trunc(&r.params, 34), trunc(&r.excitation, 34), r.fs_hz, r.samples,
-            100.0 * r.r_rmse, r.max_abs_err, if r.pass { "yes" } else { "NO" }
+            r.model,
+            trunc(&r.params, 34),
+            trunc(&r.excitation, 34),
+            r.fs_hz,
+            r.samples,
+            100.0 * r.r_rmse,
+            r.max_abs_err,
+            if r.pass { "yes" } else { "NO" }
         );
     }
     let worst = rows.iter().map(|r| r.r_rmse).fold(0.0, f64::max);
     let fails = rows.iter().filter(|r| !r.pass).count();
     s += &format!(
         "{} runs, worst R-RMSE {:.4} % (bound {:.1} %), {} over the bound\n",
-        rows.len(), 100.0 * worst, 100.0 * MAX_R_RMSE, fails
+        rows.len(),
+        100.0 * worst,
+        100.0 * MAX_R_RMSE,
+        fails
     );
     s
 }
 
 fn trunc(s: &str, n: usize) -> String {
-    if s.chars().count() <= n { s.to_owned() } else { s.chars().take(n - 1).chain(['…']).collect() }
+    if s.chars().count() <= n {
+        s.to_owned()
+    } else {
+        s.chars().take(n - 1).chain(['…']).collect()
+    }
 }
 
 pub fn run(a: AccuracyArgs) -> anyhow::Result<()> {

@@ -32,6 +32,14 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
             .with_context(|| format!("replaying {}", path.display()))?;
         replays.push((file, r));
     }
+    // The fixed-step core against f64 adaptive references (shortened runs; the full check
+    // is `hil-sim accuracy`).
+    let acc = super::accuracy::rows(&super::accuracy::AccuracyArgs {
+        model: None,
+        quick: true,
+        no_recording: false,
+        json: false,
+    })?;
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let mut md = String::from("# hil-sim demo\n\n## Models (model-core, no_std, f32, fixed step)\n\n```\n");
     md += &super::models::table();
@@ -39,8 +47,33 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     md += "| recording | samples | RMSE (N) | R-RMSE | R² | GOF |\n|---|---|---|---|---|---|\n";
     for (f, r) in &replays {
         let m = &r.metrics;
-        md += &format!("| {f} | {} | {:.1} | {:.2} % | {:.4} | {:.4} |\n", r.samples, m.rmse, 100.0 * m.r_rmse, m.r2, m.gof);
+        md += &format!(
+            "| {f} | {} | {:.1} | {:.2} % | {:.4} | {:.4} |\n",
+            r.samples,
+            m.rmse,
+            100.0 * m.r_rmse,
+            m.r2,
+            m.gof
+        );
     }
+    md += "\n## Fixed-step f32 core vs f64 adaptive reference (R-RMSE of the difference; bound 0.5 %)\n\n";
+    md += "| model | runs | worst R-RMSE | worst case |\n|---|---|---|---|\n";
+    let mut ids: Vec<&str> = acc.iter().map(|r| r.model.as_str()).collect();
+    ids.dedup();
+    for id in ids {
+        let rows: Vec<_> = acc.iter().filter(|r| r.model == id).collect();
+        if let Some(w) = rows.iter().max_by(|a, b| a.r_rmse.total_cmp(&b.r_rmse)) {
+            md += &format!(
+                "| {id} | {} | {:.4} % | {}, {} at {:.0} Hz |\n",
+                rows.len(),
+                100.0 * w.r_rmse,
+                w.params,
+                w.excitation,
+                w.fs_hz
+            );
+        }
+    }
+    md += "\nFull check: `cargo run --release -p hil-sim -- accuracy`.\n";
     let report = a.out.join("README.md");
     std::fs::write(&report, &md).with_context(|| format!("writing {}", report.display()))?;
     if a.json {
@@ -48,9 +81,11 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
             .iter()
             .map(|(f, r)| json!({"recording": f, "model": r.model, "samples": r.samples, "metrics": r.metrics}))
             .collect();
+        let worst = acc.iter().map(|r| r.r_rmse).fold(0.0, f64::max);
         return super::print_json(&json!({
             "models": model_core::MODELS.iter().map(|m| m.id).collect::<Vec<_>>(),
             "replays": reps, "report": report,
+            "accuracy": {"runs": acc.len(), "worst_r_rmse": worst, "failures": acc.iter().filter(|r| !r.pass).count()},
         }));
     }
     super::emit(&md);

@@ -119,9 +119,9 @@ pub fn progress(len: u64, what: &str) -> indicatif::ProgressBar {
     pb
 }
 
-pub fn file_arg(p: &PathBuf) -> anyhow::Result<PathBuf> {
+pub fn file_arg(p: &std::path::Path) -> anyhow::Result<PathBuf> {
     if p.is_file() {
-        Ok(p.clone())
+        Ok(p.to_path_buf())
     } else {
         bail!("{}: no such file", p.display())
     }

@@ -28,14 +28,15 @@ pub fn run(a: ModelsArgs) -> anyhow::Result<()> {
 
 /// The human-readable model table.
 pub fn table() -> String {
-    let mut s = format!("{:<19} {:>6} {:>11}  {:<40} {}\n", "model", "params", "state bytes", "source", "parameter names");
+    let mut s =
+        format!("{:<19} {:>6} {:>11}  {:<52} {}\n", "model", "params", "state bytes", "source", "parameter names");
     for m in MODELS.iter() {
         let mut names = m.params.join(", ");
         if names.len() > 60 {
             names.truncate(57);
             names.push_str("...");
         }
-        s += &format!("{:<19} {:>6} {:>11}  {:<40} {}\n", m.id, m.n_params, m.state_bytes, m.source, names);
+        s += &format!("{:<19} {:>6} {:>11}  {:<52} {}\n", m.id, m.n_params, m.state_bytes, m.source, names);
     }
     s
 }

@@ -38,11 +38,18 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
     let m = &r.metrics;
     super::emit(&format!(
         "{}: {} samples at {:.1} Hz through `{}` (f32, one step per sample)\n",
-        a.rec.display(), r.samples, 1.0 / r.dt_s, r.model
+        a.rec.display(),
+        r.samples,
+        1.0 / r.dt_s,
+        r.model
     ));
     super::emit(&format!(
         "  RMSE {:.4}  R-RMSE {:.2} %  R² {:.4}  GOF {:.4}  held samples {}\n",
-        m.rmse, 100.0 * m.r_rmse, m.r2, m.gof, r.held
+        m.rmse,
+        100.0 * m.r_rmse,
+        m.r2,
+        m.gof,
+        r.held
     ));
     Ok(())
 }
