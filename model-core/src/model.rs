@@ -72,3 +72,23 @@ pub fn write_flat(src: &[f32], out: &mut [f32]) -> usize {
     }
     n
 }
+
+/// The outputs of a bank of `N` operators (play operators, elasto-slide elements, …).
+///
+/// A named wrapper because `Default` is not implemented for arrays longer than 32.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OperatorStates<const N: usize> {
+    pub z: [f32; N],
+}
+
+impl<const N: usize> Default for OperatorStates<N> {
+    fn default() -> Self {
+        Self { z: [0.0; N] }
+    }
+}
+
+impl<const N: usize> Finite for OperatorStates<N> {
+    fn is_finite(&self) -> bool {
+        self.z.is_finite()
+    }
+}

@@ -115,22 +115,7 @@ pub struct Gpi<const N: usize> {
 }
 
 /// Outputs of the `N` generalized play operators (unit of x).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct State<const N: usize> {
-    pub z: [f32; N],
-}
-
-impl<const N: usize> Default for State<N> {
-    fn default() -> Self {
-        Self { z: [0.0; N] }
-    }
-}
-
-impl<const N: usize> Finite for State<N> {
-    fn is_finite(&self) -> bool {
-        self.z.is_finite()
-    }
-}
+pub type State<const N: usize> = crate::model::OperatorStates<N>;
 
 /// Seed 004 fits 10 and 15 operators (Tables A9–A14); 10 is the registered size.
 pub type Registered = Gpi<10>;

@@ -76,22 +76,7 @@ pub struct PrandtlIshlinskii<const N: usize> {
 }
 
 /// Outputs of the `N` play operators (unit of x).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct State<const N: usize> {
-    pub z: [f32; N],
-}
-
-impl<const N: usize> Default for State<N> {
-    fn default() -> Self {
-        Self { z: [0.0; N] }
-    }
-}
-
-impl<const N: usize> Finite for State<N> {
-    fn is_finite(&self) -> bool {
-        self.z.is_finite()
-    }
-}
+pub type State<const N: usize> = crate::model::OperatorStates<N>;
 
 /// Seed 004 fits 5 and 10 operators (Tables A7, A8); 10 is the registered size.
 pub type Registered = PrandtlIshlinskii<10>;
