@@ -13,6 +13,7 @@
 use std::path::Path;
 
 use model_core::Sample;
+use ode_solvers::dop_shared::OutputType;
 use ode_solvers::{dopri5::Dopri5, DVector, System};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -56,6 +57,38 @@ impl<F: Fn(f64) -> Input> System<f64, DVector<f64>> for Sys<'_, F> {
     }
 }
 
+/// The reference solver: Dormand–Prince 5(4), rtol 1e-10, atol 1e-12, steps of at most
+/// one sample period `dt` (so no reversal is stepped over unseen; dense output comes
+/// every `dt`), stiffness detection off (some published sets are mildly stiff; an
+/// explicit method with error control is still exact, only slower).
+fn dopri5<'a, F: Fn(f64) -> Input>(
+    sys: Sys<'a, F>,
+    s0: &[f64],
+    t0: f64,
+    t1: f64,
+    dt: f64,
+    out: OutputType,
+) -> Dopri5<f64, DVector<f64>, Sys<'a, F>> {
+    Dopri5::from_param(
+        sys,
+        t0,
+        t1,
+        dt,
+        DVector::from_column_slice(s0),
+        1e-10,
+        1e-12,
+        0.9,
+        0.0,
+        0.2,
+        10.0,
+        dt,
+        dt / 4.0,
+        u32::MAX,
+        u32::MAX,
+        out,
+    )
+}
+
 /// Integrate the reference from `t0` to `t1` with `input` valid on that interval.
 fn advance<F: Fn(f64) -> Input>(
     model: &dyn Reference,
@@ -64,27 +97,7 @@ fn advance<F: Fn(f64) -> Input>(
     t1: f64,
     input: F,
 ) -> Result<Vec<f64>, String> {
-    let h = t1 - t0;
-    let mut solver = Dopri5::from_param(
-        Sys { model, input },
-        t0,
-        t1,
-        h,
-        DVector::from_column_slice(s),
-        1e-10,
-        1e-12,
-        0.9,
-        0.0,
-        0.2,
-        10.0,
-        h,
-        h / 4.0,
-        1_000_000,
-        // Stiffness detection off: some published sets are mildly stiff, and an explicit
-        // method with error control is still exact enough, only slower.
-        u32::MAX,
-        ode_solvers::dop_shared::OutputType::Sparse,
-    );
+    let mut solver = dopri5(Sys { model, input }, s, t0, t1, t1 - t0, OutputType::Sparse);
     solver.integrate().map_err(|e| format!("reference integration failed at t = {t0}: {e}"))?;
     solver
         .y_out()
@@ -107,25 +120,7 @@ fn dense_outputs(
         return Err(format!("reference init gave {} states, dim() says {}", s0.len(), model.dim()));
     }
     let t_end = (n - 1) as f64 * dt;
-    let mut solver = Dopri5::from_param(
-        Sys { model, input: &input_at },
-        0.0,
-        t_end,
-        dt,
-        DVector::from_column_slice(&s0),
-        1e-10,
-        1e-12,
-        0.9,
-        0.0,
-        0.2,
-        10.0,
-        // At most one sample period per step, so no reversal is stepped over unseen.
-        dt,
-        dt / 4.0,
-        u32::MAX,
-        u32::MAX,
-        ode_solvers::dop_shared::OutputType::Dense,
-    );
+    let mut solver = dopri5(Sys { model, input: &input_at }, &s0, 0.0, t_end, dt, OutputType::Dense);
     solver.integrate().map_err(|e| format!("reference integration failed: {e}"))?;
     let (ts, ys) = (solver.x_out(), solver.y_out());
     if ts.len() < n {
