@@ -5,6 +5,7 @@ pub mod accuracy;
 pub mod data;
 pub mod dispatch;
 pub mod excitation;
+pub mod fit;
 pub mod metrics;
 pub mod params_file;
 pub mod recording;

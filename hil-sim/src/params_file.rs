@@ -47,6 +47,9 @@ pub struct ParamsFile {
     pub model: String,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub source: Option<String>,
+    /// Rate estimator the set was fitted with (`--rate` syntax); replay uses it by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rate: Option<String>,
     pub params: Values,
 }
 
@@ -115,7 +118,7 @@ impl ParamsFile {
             let v: Vec<f64> = it.by_ref().take(len).collect();
             map.insert(key.to_owned(), if len == 1 { Value::One(*v.first()?) } else { Value::Block(v) });
         }
-        Some(Self { model: model.to_owned(), source, params: Values::Named(map) })
+        Some(Self { model: model.to_owned(), source, rate: None, params: Values::Named(map) })
     }
 }
 

@@ -28,7 +28,7 @@ impl Finite for () {
 /// Implementors are built by a fallible constructor (`new(..)` in the paper's form, or
 /// [`Model::from_params`] from a flat vector in [`Model::PARAM_NAMES`] order) that checks
 /// every bound once; [`Model::step`] then cannot fail and allocates nothing.
-pub trait Model: Copy + core::fmt::Debug {
+pub trait Model: Copy + core::fmt::Debug + 'static {
     /// Internal state: plain `Copy` data, all zeros (`Default`) at rest.
     type State: Copy + Default + core::fmt::Debug + PartialEq + Finite;
 

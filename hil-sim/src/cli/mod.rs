@@ -3,6 +3,7 @@
 
 mod accuracy;
 mod demo;
+mod fit;
 mod models;
 mod replay;
 
@@ -26,6 +27,8 @@ pub enum Cmd {
     Models(models::ModelsArgs),
     /// Run a recording through the no_std core in f32, one step per sample.
     Replay(replay::ReplayArgs),
+    /// Identify model parameters on the first part of a recording and score the rest.
+    Fit(fit::FitArgs),
     /// Check the f32 fixed-step core against f64 adaptive-step references.
     Accuracy(accuracy::AccuracyArgs),
     /// The main job on the bundled data (see README).
@@ -36,6 +39,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.cmd {
         Cmd::Models(a) => models::run(a),
         Cmd::Replay(a) => replay::run(a),
+        Cmd::Fit(a) => fit::run(a),
         Cmd::Accuracy(a) => accuracy::run(a),
         Cmd::Demo(a) => demo::run(a),
     }
@@ -56,8 +60,9 @@ pub struct ChannelArgs {
     /// Channel driving current/voltage-dependent parameters (`Y` for the damper files).
     #[arg(long)]
     pub command: Option<String>,
-    /// Rate estimator: `backward`, `filtered:FC_HZ` or `kalman[:Q:R]` (seed 002).
-    #[arg(long, default_value = "backward")]
+    /// Rate estimator: `backward`, `filtered:FC_HZ`, `kalman[:Q:R]` (seed 002), or `auto`
+    /// (each model's own choice when fitting; the parameter file's, else backward, when replaying).
+    #[arg(long, default_value = "auto")]
     pub rate: String,
 }
 
@@ -70,8 +75,13 @@ impl ChannelArgs {
             command: self.command.clone(),
         }
     }
-    pub fn rate(&self) -> anyhow::Result<RateChoice> {
-        parse_rate(&self.rate)
+    /// The rate estimator named by `--rate`; `None` for `auto`.
+    pub fn rate(&self) -> anyhow::Result<Option<RateChoice>> {
+        if self.rate == "auto" {
+            Ok(None)
+        } else {
+            parse_rate(&self.rate).map(Some)
+        }
     }
 }
 

@@ -23,8 +23,12 @@ pub struct ReplayArgs {
 }
 
 pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
-    let rate = a.ch.rate()?;
     let pf = ParamsFile::read(&a.params)?;
+    let rate = match (a.ch.rate()?, pf.rate.as_deref()) {
+        (Some(r), _) => r,
+        (None, Some(r)) => super::parse_rate(r).with_context(|| format!("{}: `rate`", a.params.display()))?,
+        (None, None) => hil_sim::dispatch::RateChoice::Backward,
+    };
     let flat = pf.flat(&a.params)?;
     let rec = Recording::read_csv(&super::file_arg(&a.rec)?)?;
     let r = replay_recording(&rec, &a.ch.channels(), &pf.model, &flat, rate)

@@ -1,0 +1,151 @@
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{bail, Context};
+use clap::Args;
+use hil_sim::fit::spec::FITTABLE;
+use hil_sim::fit::{fit, Dataset, FitOptions, FitResult};
+use hil_sim::params_file::ParamsFile;
+use hil_sim::recording::Recording;
+use rayon::prelude::*;
+use serde_json::json;
+
+use super::ChannelArgs;
+
+#[derive(Args, Debug)]
+pub struct FitArgs {
+    /// Recording (CSV).
+    pub rec: PathBuf,
+    /// Model id (see `hil-sim models`), a comma-separated list, or `all`.
+    #[arg(long, default_value = "all")]
+    pub model: String,
+    /// Fraction of the recording (time-ordered, from the start) used for fitting; the rest
+    /// is held out and scored.
+    #[arg(long, default_value_t = 0.7)]
+    pub train: f64,
+    #[command(flatten)]
+    pub ch: ChannelArgs,
+    /// Seed of the global search (results are reproducible for a given seed).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Write each fitted set as `<DIR>/<model>.json` (a `replay --params` file).
+    #[arg(long)]
+    pub save: Option<PathBuf>,
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The models `--model` names.
+pub fn model_list(arg: &str) -> anyhow::Result<Vec<String>> {
+    if arg == "all" {
+        return Ok(FITTABLE.iter().map(|s| (*s).to_owned()).collect());
+    }
+    let list: Vec<String> = arg.split(',').map(|s| s.trim().to_owned()).filter(|s| !s.is_empty()).collect();
+    for id in &list {
+        if model_core::registry::find(id).is_none() {
+            bail!("--model {id}: unknown model (see `hil-sim models`)");
+        }
+        if !FITTABLE.contains(&id.as_str()) {
+            bail!("--model {id}: not fitted by this build (fittable: {})", FITTABLE.join(", "));
+        }
+    }
+    if list.is_empty() {
+        bail!("--model: no model named");
+    }
+    Ok(list)
+}
+
+/// Fit each model in `ids`, with a progress bar; results in the order of `ids`.
+pub fn fit_all(data: &Dataset, ids: &[String], opts: &FitOptions) -> anyhow::Result<Vec<FitResult>> {
+    let pb = super::progress(ids.len() as u64, "fitting");
+    // Models run one after another; each fit is parallel inside (swarm, Jacobian columns).
+    let mut out = Vec::with_capacity(ids.len());
+    for id in ids {
+        pb.set_message(id.clone());
+        let r = fit(id, data, opts).with_context(|| format!("fitting `{id}`"))?;
+        pb.inc(1);
+        out.push(r);
+    }
+    pb.finish_and_clear();
+    Ok(out)
+}
+
+pub fn run(a: FitArgs) -> anyhow::Result<()> {
+    let ids = model_list(&a.model)?;
+    let rate = a.ch.rate()?;
+    let path = super::file_arg(&a.rec)?;
+    let rec = Recording::read_csv(&path)?;
+    let data = Dataset::new(&rec, &a.ch.channels(), a.train, None).with_context(|| format!("{}", path.display()))?;
+    let opts = FitOptions { rate, swarm: hil_sim::fit::global::SwarmOptions { seed: a.seed, ..Default::default() }, ..Default::default() };
+    let t0 = Instant::now();
+    let results = fit_all(&data, &ids, &opts)?;
+    let total = t0.elapsed().as_secs_f64();
+    if let Some(dir) = &a.save {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        results.par_iter().try_for_each(|r| -> anyhow::Result<()> {
+            let flat: Vec<f32> = r.flat.iter().map(|v| *v as f32).collect();
+            let mut pf = ParamsFile::from_flat(&r.model, Some(format!("hil-sim fit {}", path.display())), &flat)
+                .context("building the parameter file")?;
+            pf.rate = Some(r.rate.clone());
+            let file = dir.join(format!("{}.json", r.model));
+            std::fs::write(&file, serde_json::to_string_pretty(&pf)? + "\n")
+                .with_context(|| format!("writing {}", file.display()))
+        })?;
+    }
+    let best = results
+        .iter()
+        .filter(|r| r.heldout.rmse.is_finite())
+        .min_by(|x, y| x.heldout.rmse.total_cmp(&y.heldout.rmse))
+        .map(|r| r.model.clone());
+    if a.json {
+        return super::print_json(&json!({
+            "recording": path.display().to_string(),
+            "samples": data.len(),
+            "dt_s": data.dt,
+            "train_fraction": a.train,
+            "train_samples": data.train_end,
+            "heldout_samples": data.len() - data.train_end,
+            "results": results,
+            "best": best,
+            "total_seconds": total,
+        }));
+    }
+    super::emit(&format!(
+        "{}: {} samples at {:.1} Hz; fit on the first {:.0} % ({} samples), scored on the last {} samples\n\n",
+        path.display(),
+        data.len(),
+        1.0 / data.dt,
+        100.0 * a.train,
+        data.train_end,
+        data.len() - data.train_end
+    ));
+    super::emit(&table(&results));
+    if let Some(b) = best {
+        super::emit(&format!("\nbest held-out: {b}; total {total:.2} s\n"));
+    }
+    Ok(())
+}
+
+/// The comparison table, one row per model.
+pub fn table(results: &[FitResult]) -> String {
+    let mut s = format!(
+        "{:<16} {:>6} {:>10} {:>9} {:>8} {:>10} {:>9} {:>8} {:>8} {:>9}\n",
+        "model", "params", "train RMSE", "train R²", "method", "held RMSE", "held R²", "R-RMSE", "fit s", "ns/step"
+    );
+    for r in results {
+        s += &format!(
+            "{:<16} {:>6} {:>10.4} {:>9.4} {:>8} {:>10.4} {:>9.4} {:>7.2}% {:>8.3} {:>9.1}\n",
+            r.model,
+            r.free_params,
+            r.train.rmse,
+            r.train.r2,
+            format!("{:?}", r.method).to_lowercase(),
+            r.heldout.rmse,
+            r.heldout.r2,
+            100.0 * r.heldout.r_rmse,
+            r.fit_seconds,
+            r.replay_ns_per_sample
+        );
+    }
+    s
+}

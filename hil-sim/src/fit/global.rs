@@ -1,0 +1,115 @@
+//! Global search for models with local minima (Bouc–Wen family, LuGre, Dahl, trig): a
+//! particle swarm (argmin's `ParticleSwarm`, costs evaluated in parallel) over the unit box
+//! of the free parameters, seeded with the spec's starting point. It returns the best few
+//! distinct points it saw, for Levenberg–Marquardt to polish.
+
+use std::sync::Mutex;
+
+use argmin::core::{CostFunction, Error, Executor, PopulationState};
+use argmin::solver::particleswarm::{Particle, ParticleSwarm};
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+use rayon::prelude::*;
+
+use super::objective::Objective;
+
+/// Size of the swarm search.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SwarmOptions {
+    pub particles: usize,
+    pub iterations: u64,
+    pub seed: u64,
+    /// How many distinct candidates to return.
+    pub keep: usize,
+}
+
+impl Default for SwarmOptions {
+    fn default() -> Self {
+        Self { particles: 32, iterations: 40, seed: 1, keep: 3 }
+    }
+}
+
+/// One point of the search, as a full parameter vector.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Candidate {
+    pub params: Vec<f64>,
+    pub cost: f64,
+}
+
+struct Cost<'a, 'b> {
+    obj: &'b Objective<'a>,
+    /// Best distinct points seen so far (unit-box positions), best first.
+    best: &'b Mutex<Vec<(f64, Vec<f64>)>>,
+    keep: usize,
+}
+
+/// Two unit-box points closer than this (max-norm) count as the same basin.
+const DISTINCT: f64 = 0.05;
+
+impl Cost<'_, '_> {
+    fn record(&self, cost: f64, unit: &[f64]) {
+        if !cost.is_finite() {
+            return;
+        }
+        let Ok(mut best) = self.best.lock() else { return };
+        let near = |u: &Vec<f64>| u.iter().zip(unit).all(|(a, b)| (a - b).abs() < DISTINCT);
+        if let Some(pos) = best.iter().position(|(_, u)| near(u)) {
+            if best.get(pos).is_some_and(|(c, _)| cost < *c) {
+                best.remove(pos);
+            } else {
+                return;
+            }
+        }
+        let at = best.iter().position(|(c, _)| cost < *c).unwrap_or(best.len());
+        if at < self.keep {
+            best.insert(at, (cost, unit.to_vec()));
+            best.truncate(self.keep);
+        }
+    }
+}
+
+impl CostFunction for Cost<'_, '_> {
+    type Param = Vec<f64>;
+    type Output = f64;
+    fn cost(&self, unit: &Vec<f64>) -> Result<f64, Error> {
+        let c = self.obj.cost(&self.obj.from_unit(unit));
+        self.record(c, unit);
+        // The swarm compares costs; an invalid point is simply the worst.
+        Ok(if c.is_finite() { c } else { f64::MAX })
+    }
+}
+
+/// Search the box of `obj`'s free parameters. The spec's starting point is one of the
+/// particles, so the result is never worse than the start.
+pub fn search(obj: &Objective<'_>, opts: SwarmOptions) -> Result<Vec<Candidate>, Error> {
+    let n = obj.free.len();
+    let best = Mutex::new(Vec::new());
+    let cost = Cost { obj, best: &best, keep: opts.keep.max(1) };
+    if n == 0 {
+        let p = obj.spec.start();
+        return Ok(vec![Candidate { cost: obj.cost(&p), params: p }]);
+    }
+    let mut rng = StdRng::seed_from_u64(opts.seed);
+    let mut points: Vec<Vec<f64>> = vec![obj.to_unit(&obj.spec.start())];
+    while points.len() < opts.particles.max(2) {
+        points.push((0..n).map(|_| rng.random::<f64>()).collect());
+    }
+    let costs: Vec<f64> = points.par_iter().map(|u| cost.cost(u).unwrap_or(f64::MAX)).collect();
+    let population: Vec<Particle<Vec<f64>, f64>> = points
+        .into_iter()
+        .zip(costs)
+        .map(|(u, c)| {
+            let v: Vec<f64> = (0..n).map(|_| 0.1 * (rng.random::<f64>() - 0.5)).collect();
+            Particle::new(u, c, v)
+        })
+        .collect();
+    let solver = ParticleSwarm::new((vec![0.0; n], vec![1.0; n]), population.len())
+        .with_rng_generator(StdRng::seed_from_u64(opts.seed.wrapping_add(1)));
+    Executor::new(cost, solver)
+        .configure(|s: PopulationState<Particle<Vec<f64>, f64>, f64>| {
+            s.population(population).max_iters(opts.iterations)
+        })
+        .run()?;
+    let best = best.into_inner().map_err(|_| Error::msg("swarm bookkeeping poisoned"))?;
+    Ok(best.into_iter().map(|(c, u)| Candidate { params: obj.from_unit(&u), cost: c }).collect())
+}

@@ -1,0 +1,356 @@
+//! Identification: fit any model's parameters to a recording, with the exact f32 core the
+//! firmware runs, and score the result on held-out data.
+//!
+//! - [`Dataset`]: one recording's input, output and command, the time-ordered train /
+//!   held-out split and the samples the quality checks flagged.
+//! - [`spec`]: per model, the search box and starting values (from the papers, rescaled to
+//!   the recording's units) and the method.
+//! - Methods: closed-form least squares ([`linear`]) where the model is linear in its
+//!   parameters; particle swarm ([`global`]) then bounded Levenberg–Marquardt ([`lm`])
+//!   for the models with local minima.
+//! - [`fit`] returns the parameters and all metrics of the contract, train and held-out,
+//!   from a replay through [`crate::dispatch::replay`] — the `Estimator` path, f32.
+
+pub mod global;
+pub mod linear;
+pub mod lm;
+pub mod objective;
+pub mod simulate;
+pub mod spec;
+
+use std::time::Instant;
+
+use model_core::Sample;
+use serde::Serialize;
+use thiserror::Error;
+
+use crate::dispatch::{replay, RateChoice};
+use crate::metrics::{metrics, Metrics};
+use crate::params_file::{ParamsFile, Values};
+use crate::recording::{Recording, RecordingError};
+use crate::replay::{gradient, Channels};
+use global::SwarmOptions;
+use objective::Objective;
+use spec::{ModelSpec, Scales, Strategy};
+
+/// Why a fit could not run.
+#[derive(Debug, Error)]
+pub enum FitError {
+    #[error(transparent)]
+    Recording(#[from] RecordingError),
+    #[error("--train {0}: must be a fraction strictly between 0 and 1")]
+    TrainFraction(f64),
+    #[error("the training part has only {0} usable samples (need at least 20)")]
+    TooFewSamples(usize),
+    #[error("the held-out part is empty (lower --train)")]
+    NoHeldOut,
+    #[error("unknown model `{0}` (see `hil-sim models`)")]
+    UnknownModel(String),
+    #[error("model `{0}` is not fitted by this build (fittable: {list})", list = spec::FITTABLE.join(", "))]
+    NotFittable(String),
+    #[error("{model}: the rate estimate overflows on this input")]
+    RateOverflow { model: String },
+    #[error("{model}: no valid parameter set found in the search box")]
+    NoValidSet { model: String },
+    #[error("{model}: swarm search failed: {reason}")]
+    Swarm { model: String, reason: String },
+    #[error("{model}: replay of the fitted set failed: {reason}")]
+    Replay { model: String, reason: String },
+}
+
+/// The data a fit works on.
+#[derive(Clone, Debug)]
+pub struct Dataset {
+    /// Mean sample interval, seconds: the core's fixed step.
+    pub dt: f64,
+    pub time: Vec<f64>,
+    pub input: Vec<f64>,
+    pub output: Vec<f64>,
+    pub command: Option<Vec<f64>>,
+    /// First held-out sample.
+    pub train_end: usize,
+    /// Samples the quality checks flagged (excluded from the fit and from the scores).
+    pub excluded: Vec<bool>,
+}
+
+impl Dataset {
+    /// Take the channels `ch` of `rec` and split at `train` (fraction of the samples, time-ordered).
+    /// `excluded` marks flagged samples (`None`: none).
+    pub fn new(rec: &Recording, ch: &Channels, train: f64, excluded: Option<Vec<bool>>) -> Result<Self, FitError> {
+        if !(train > 0.0 && train < 1.0) {
+            return Err(FitError::TrainFraction(train));
+        }
+        let time = rec.time(&ch.time)?.to_vec();
+        let input = rec.channel(&ch.input)?.to_vec();
+        let output = rec.channel(&ch.output)?.to_vec();
+        let command = ch.command.as_deref().map(|c| rec.channel(c).map(<[f64]>::to_vec)).transpose()?;
+        let dt = rec.mean_dt(&ch.time)?;
+        let n = input.len();
+        let train_end = ((n as f64) * train).round() as usize;
+        if train_end >= n {
+            return Err(FitError::NoHeldOut);
+        }
+        let excluded = excluded.filter(|e| e.len() == n).unwrap_or_else(|| vec![false; n]);
+        let d = Self { dt, time, input, output, command, train_end, excluded };
+        let usable = d.train_rows().len();
+        if usable < 20 {
+            return Err(FitError::TooFewSamples(usable));
+        }
+        Ok(d)
+    }
+
+    pub fn len(&self) -> usize {
+        self.input.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.input.is_empty()
+    }
+
+    /// The samples as the core sees them (f32, with the command when there is one).
+    pub fn samples(&self) -> Vec<Sample> {
+        self.input
+            .iter()
+            .enumerate()
+            .map(|(i, x)| {
+                let s = Sample::new(*x as f32);
+                match self.command.as_ref().and_then(|u| u.get(i)) {
+                    Some(u) => s.with_command(*u as f32),
+                    None => s,
+                }
+            })
+            .collect()
+    }
+
+    /// Training samples that enter the fit.
+    pub fn train_rows(&self) -> Vec<usize> {
+        (0..self.train_end).filter(|&i| !self.excluded.get(i).copied().unwrap_or(false)).collect()
+    }
+
+    /// Held-out samples that are scored.
+    pub fn heldout_rows(&self) -> Vec<usize> {
+        (self.train_end..self.len()).filter(|&i| !self.excluded.get(i).copied().unwrap_or(false)).collect()
+    }
+
+    /// Spreads of the training part (see [`Scales`]).
+    pub fn scales(&self) -> Scales {
+        let rows = self.train_rows();
+        let pick = |v: &[f64]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
+        let mean_std = |v: &[f64]| {
+            let n = v.len().max(1) as f64;
+            let m = v.iter().sum::<f64>() / n;
+            (m, (v.iter().map(|a| (a - m) * (a - m)).sum::<f64>() / n).sqrt())
+        };
+        let x = pick(&self.input);
+        let dx = gradient(&self.input, self.dt);
+        let ddx = gradient(&dx, self.dt);
+        let (x_mean, xs) = mean_std(&x);
+        let (y_mean, ys) = mean_std(&pick(&self.output));
+        let u = self.command.as_ref().map(|u| pick(u).iter().fold(0.0f64, |a, b| a.max(b.abs())));
+        Scales {
+            x_mean,
+            x: xs,
+            dx: mean_std(&pick(&dx)).1,
+            ddx: mean_std(&pick(&ddx)).1,
+            y_mean,
+            y: ys,
+            u: u.filter(|u| *u > 0.0),
+        }
+    }
+}
+
+/// How hard to search.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FitOptions {
+    /// Rate estimator for every model (`None`: each model's preferred one).
+    pub rate: Option<RateChoice>,
+    pub swarm: SwarmOptions,
+    /// Samples of the training part the swarm scores (the start of it), to keep the global
+    /// phase cheap; Levenberg–Marquardt then uses the whole training part.
+    pub swarm_window: usize,
+    /// Residual evaluations allowed to each Levenberg–Marquardt run.
+    pub lm_evaluations: usize,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        Self { rate: None, swarm: SwarmOptions::default(), swarm_window: 15_000, lm_evaluations: 400 }
+    }
+}
+
+/// One model's result, in the contract's shape (`model, params, train, heldout, fit_seconds`).
+#[derive(Clone, Debug, Serialize)]
+pub struct FitResult {
+    pub model: String,
+    /// Fitted parameters by name (blocks as arrays).
+    pub params: Values,
+    pub train: Metrics,
+    pub heldout: Metrics,
+    /// Held-out metrics including the flagged samples, when some were flagged.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub heldout_with_flagged: Option<Metrics>,
+    pub fit_seconds: f64,
+    pub method: Strategy,
+    /// Rate estimator used (`backward`, `filtered:FC`, `kalman:Q:R`).
+    pub rate: String,
+    /// Model evaluations over the training data.
+    pub evaluations: usize,
+    /// Wall time of the f32 replay per sample, nanoseconds.
+    pub replay_ns_per_sample: f64,
+    pub n_params: usize,
+    pub free_params: usize,
+    pub state_bytes: usize,
+    /// Samples whose output the core held (non-finite or overflow) in the replay.
+    pub held: usize,
+    /// Flat parameter vector (registry order).
+    #[serde(skip)]
+    pub flat: Vec<f64>,
+    /// The replayed output over the whole recording.
+    #[serde(skip)]
+    pub output: Vec<f64>,
+}
+
+/// `backward`, `filtered:FC`, `kalman:Q:R`, the syntax of `--rate`.
+pub fn rate_name(r: RateChoice) -> String {
+    match r {
+        RateChoice::Backward => "backward".into(),
+        RateChoice::Filtered(fc) => format!("filtered:{fc}"),
+        RateChoice::Kalman { q, r } => format!("kalman:{q}:{r}"),
+    }
+}
+
+/// Fit model `id` to `data`.
+pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, FitError> {
+    let info = model_core::registry::find(id).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
+    let scales = data.scales();
+    let sp = spec::spec(id, &scales, opts.rate).ok_or_else(|| FitError::NotFittable(id.to_owned()))?;
+    let started = Instant::now();
+    let dt = data.dt as f32;
+    let samples = data.samples();
+    let kin = simulate::kinematics(&samples, dt, sp.rate).ok_or(FitError::RateOverflow { model: id.to_owned() })?;
+    let sim = simulate::simulator(id, dt).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
+    let rows = data.train_rows();
+    let (params, evaluations) = identify(id, &sp, sim.as_ref(), &kin, &data.output, &rows, scales.y, opts)?;
+    let fit_seconds = started.elapsed().as_secs_f64();
+
+    // Score with the Estimator path, the firmware's code, over the whole recording.
+    let p32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
+    let t0 = Instant::now();
+    let rep = replay(id, &p32, dt, sp.rate, &samples)
+        .map_err(|e| FitError::Replay { model: id.to_owned(), reason: e.to_string() })?;
+    let replay_ns = t0.elapsed().as_secs_f64() * 1e9 / samples.len().max(1) as f64;
+    let output: Vec<f64> = rep.y.iter().map(|v| f64::from(*v)).collect();
+    let dx = gradient(&data.input, data.dt);
+    let ddx = gradient(&dx, data.dt);
+    let score = |rows: &[usize]| {
+        let pick = |v: &[f64]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
+        metrics(&pick(&data.output), &pick(&output), Some((&pick(&dx), &pick(&ddx))))
+    };
+    let heldout_rows = data.heldout_rows();
+    if std::env::var_os("HIL_SIM_DEBUG").is_some() {
+        let mut seg = Vec::new();
+        let mut a = data.train_end;
+        while a < data.len() {
+            let b = (a + 1000).min(data.len());
+            let r: Vec<usize> = (a..b).collect();
+            seg.push(format!("{:.1}s:{:.0}", data.time.get(a).copied().unwrap_or(0.0), score(&r).rmse));
+            a = b;
+        }
+        eprintln!("{id}: held-out RMSE per 1000 samples: {}", seg.join(" "));
+    }
+    let all_heldout: Vec<usize> = (data.train_end..data.len()).collect();
+    let flat32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
+    let named = ParamsFile::from_flat(id, None, &flat32).map(|f| f.params).unwrap_or(Values::Flat(params.clone()));
+    Ok(FitResult {
+        model: id.to_owned(),
+        params: named,
+        train: score(&rows),
+        heldout: score(&heldout_rows),
+        heldout_with_flagged: (heldout_rows.len() != all_heldout.len()).then(|| score(&all_heldout)),
+        fit_seconds,
+        method: sp.strategy,
+        rate: rate_name(sp.rate),
+        evaluations,
+        replay_ns_per_sample: replay_ns,
+        n_params: info.n_params,
+        free_params: sp.free().len(),
+        state_bytes: info.state_bytes,
+        held: rep.held,
+        flat: params,
+        output,
+    })
+}
+
+/// The search itself: returns the parameters and the number of model evaluations.
+#[allow(clippy::too_many_arguments)]
+fn identify(
+    id: &str,
+    sp: &ModelSpec,
+    sim: &dyn simulate::Simulator,
+    kin: &[model_core::Kin],
+    y: &[f64],
+    rows: &[usize],
+    y_scale: f64,
+    opts: &FitOptions,
+) -> Result<(Vec<f64>, usize), FitError> {
+    let full = Objective::new(sim, sp, kin, y, rows, y_scale);
+    match sp.strategy {
+        Strategy::Linear => {
+            let p = linear::solve(id, kin, y, rows, &sp.free(), &sp.start())
+                .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
+            if sim.valid(&p) {
+                return Ok((p, 1));
+            }
+            // A sign bound is active: continue from the box-clamped solution under LM.
+            let clamped: Vec<f64> = p.iter().zip(&sp.params).map(|(v, ps)| v.clamp(ps.lo, ps.hi)).collect();
+            let r = lm::minimize(&full, &clamped, opts.lm_evaluations);
+            valid_or_err(id, sim, r.params, r.evaluations + 1)
+        }
+        Strategy::Local => {
+            let r = lm::minimize(&full, &sp.start(), opts.lm_evaluations);
+            valid_or_err(id, sim, r.params, r.evaluations)
+        }
+        Strategy::Global => {
+            let window_rows: Vec<usize> = rows.iter().copied().filter(|&i| i < opts.swarm_window).collect();
+            let window_rows = if window_rows.len() < 20 { rows.to_vec() } else { window_rows };
+            let win = Objective::new(sim, sp, kin, y, &window_rows, y_scale);
+            let cands = global::search(&win, opts.swarm)
+                .map_err(|e| FitError::Swarm { model: id.to_owned(), reason: e.to_string() })?;
+            let mut evals = opts.swarm.particles * (opts.swarm.iterations as usize + 1);
+            if std::env::var_os("HIL_SIM_DEBUG").is_some() {
+                eprintln!("{id}: swarm {:?}", cands.iter().map(|c| c.cost).collect::<Vec<_>>());
+            }
+            // Polish every candidate on the window, then the best on the whole training part.
+            let mut best: Option<lm::LocalFit> = None;
+            for c in &cands {
+                let r = lm::minimize(&win, &c.params, opts.lm_evaluations / 2);
+                evals += r.evaluations;
+                if std::env::var_os("HIL_SIM_DEBUG").is_some() {
+                    eprintln!("{id}: window LM {} -> {} ({} evals, {})", c.cost, r.cost, r.evaluations, r.termination);
+                }
+                if r.cost.is_finite() && best.as_ref().is_none_or(|b| r.cost < b.cost) {
+                    best = Some(r);
+                }
+            }
+            let start = best.map(|b| b.params).ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
+            let r = lm::minimize(&full, &start, opts.lm_evaluations);
+            evals += r.evaluations;
+            if std::env::var_os("HIL_SIM_DEBUG").is_some() {
+                eprintln!("{id}: full LM -> {} ({} evals, {}) {:?}", r.cost, r.evaluations, r.termination, r.params);
+            }
+            valid_or_err(id, sim, r.params, evals)
+        }
+    }
+}
+
+fn valid_or_err(
+    id: &str,
+    sim: &dyn simulate::Simulator,
+    p: Vec<f64>,
+    evals: usize,
+) -> Result<(Vec<f64>, usize), FitError> {
+    if sim.valid(&p) {
+        Ok((p, evals))
+    } else {
+        Err(FitError::NoValidSet { model: id.to_owned() })
+    }
+}
