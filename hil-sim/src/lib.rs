@@ -7,6 +7,7 @@ pub mod dispatch;
 pub mod excitation;
 pub mod metrics;
 pub mod params_file;
+pub mod quality;
 pub mod recording;
 pub mod reference;
 pub mod replay;

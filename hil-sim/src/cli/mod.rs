@@ -59,6 +59,10 @@ pub struct ChannelArgs {
     /// Rate estimator: `backward`, `filtered:FC_HZ` or `kalman[:Q:R]` (seed 002).
     #[arg(long, default_value = "backward")]
     pub rate: String,
+    /// Keep the samples the data-quality check flags (clipped, standstill, dropout,
+    /// spike, non-uniform sampling) in the fit; by default they are excluded.
+    #[arg(long)]
+    pub keep_flagged: bool,
 }
 
 impl ChannelArgs {
