@@ -167,7 +167,7 @@ fn type_name(t: u32) -> String {
 /// Numbers of any numeric storage type, widened to f64.
 fn numbers(t: u32, data: &[u8], e: Endian, at: usize) -> R<Vec<f64>> {
     fn each<const N: usize>(data: &[u8], at: usize, f: impl Fn([u8; N]) -> f64) -> R<Vec<f64>> {
-        if data.len() % N != 0 {
+        if !data.len().is_multiple_of(N) {
             return Err(Fault::Format(format!(
                 "element at byte {at}: {} bytes is not a whole number of values",
                 data.len()
