@@ -1,6 +1,6 @@
 //! Recordings: CSV files as the lab writes them (quoted header, trailing comma on every
 //! row, a column filled only on its first row, as in `shared/data/dyke/`), and MATLAB
-//! level-5 MAT-files (one variable per channel, [`mat`]). [`Recording::read`] picks the
+//! level-5 MAT-files (one variable per channel, `recording/mat.rs`). [`Recording::read`] picks the
 //! reader by the file's first bytes and its extension.
 //!
 //! Every rejection is a [`RecordingError`] naming the file, the line (CSV) or the sample
