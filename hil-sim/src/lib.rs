@@ -8,6 +8,7 @@ pub mod excitation;
 pub mod fit;
 pub mod metrics;
 pub mod params_file;
+pub mod quality;
 pub mod recording;
 pub mod reference;
 pub mod replay;

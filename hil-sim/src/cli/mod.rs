@@ -64,6 +64,10 @@ pub struct ChannelArgs {
     /// (each model's own choice when fitting; the parameter file's, else backward, when replaying).
     #[arg(long, default_value = "auto")]
     pub rate: String,
+    /// Keep the samples the data-quality check flags (clipped, standstill, dropout,
+    /// spike, non-uniform sampling) in the fit; by default they are excluded.
+    #[arg(long)]
+    pub keep_flagged: bool,
 }
 
 impl ChannelArgs {

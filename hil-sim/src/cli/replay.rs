@@ -3,6 +3,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use hil_sim::params_file::ParamsFile;
+use hil_sim::quality;
 use hil_sim::recording::Recording;
 use hil_sim::replay::replay_recording;
 use serde_json::json;
@@ -11,7 +12,7 @@ use super::ChannelArgs;
 
 #[derive(Args, Debug)]
 pub struct ReplayArgs {
-    /// Recording (CSV).
+    /// Recording (CSV or level-5 MAT-file).
     pub rec: PathBuf,
     /// Parameter file (JSON: `{"model": ID, "params": {...}}`).
     #[arg(long)]
@@ -30,13 +31,18 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
         (None, None) => hil_sim::dispatch::RateChoice::Backward,
     };
     let flat = pf.flat(&a.params)?;
-    let rec = Recording::read_csv(&super::file_arg(&a.rec)?)?;
+    let rec = Recording::read(&super::file_arg(&a.rec)?)?;
+    let q = quality::check(&rec, &a.ch.channels())?;
+    for w in &q.warnings {
+        eprintln!("warning: {}", w.message);
+    }
     let r = replay_recording(&rec, &a.ch.channels(), &pf.model, &flat, rate)
         .with_context(|| format!("replaying {}", a.rec.display()))?;
     if a.json {
         return super::print_json(&json!({
             "model": r.model, "samples": r.samples, "dt_s": r.dt_s,
             "metrics": r.metrics, "held": r.held,
+            "warnings": q.warnings, "excluded_samples": q.excluded_samples,
         }));
     }
     let m = &r.metrics;
