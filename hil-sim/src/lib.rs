@@ -7,6 +7,8 @@ pub mod dispatch;
 pub mod excitation;
 pub mod metrics;
 pub mod params_file;
+pub mod plot;
 pub mod recording;
 pub mod reference;
 pub mod replay;
+pub mod report;
