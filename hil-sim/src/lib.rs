@@ -9,6 +9,8 @@ pub mod fit;
 pub mod metrics;
 pub mod params_file;
 pub mod quality;
+pub mod plot;
 pub mod recording;
 pub mod reference;
 pub mod replay;
+pub mod report;
