@@ -2,6 +2,7 @@
 //! accuracy checks of the fixed-step core.
 
 pub mod accuracy;
+pub mod compare;
 pub mod data;
 pub mod dispatch;
 pub mod excitation;

@@ -6,6 +6,7 @@ use clap::Args;
 use hil_sim::fit::spec::FITTABLE;
 use hil_sim::fit::{fit, Dataset, FitOptions, FitResult};
 use hil_sim::params_file::ParamsFile;
+use hil_sim::quality;
 use hil_sim::recording::Recording;
 use rayon::prelude::*;
 use serde_json::json;
@@ -74,9 +75,16 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
     let ids = model_list(&a.model)?;
     let rate = a.ch.rate()?;
     let path = super::file_arg(&a.rec)?;
-    let rec = Recording::read_csv(&path)?;
-    let data = Dataset::new(&rec, &a.ch.channels(), a.train, None).with_context(|| format!("{}", path.display()))?;
-    let opts = FitOptions { rate, swarm: hil_sim::fit::global::SwarmOptions { seed: a.seed, ..Default::default() }, ..Default::default() };
+    let rec = Recording::read(&path)?;
+    let ch = a.ch.channels();
+    let q = quality::check(&rec, &ch)?;
+    for w in &q.warnings {
+        eprintln!("warning: {}", w.message);
+    }
+    let excluded = (!a.ch.keep_flagged).then(|| q.excluded());
+    let data = Dataset::new(&rec, &ch, a.train, excluded).with_context(|| format!("{}", path.display()))?;
+    let mut opts = FitOptions { rate, ..Default::default() };
+    opts.swarm.seed = a.seed;
     let t0 = Instant::now();
     let results = fit_all(&data, &ids, &opts)?;
     let total = t0.elapsed().as_secs_f64();
@@ -105,6 +113,8 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
             "train_fraction": a.train,
             "train_samples": data.train_end,
             "heldout_samples": data.len() - data.train_end,
+            "warnings": q.warnings,
+            "excluded_samples": if a.ch.keep_flagged { 0 } else { q.excluded_samples },
             "results": results,
             "best": best,
             "total_seconds": total,

@@ -10,6 +10,7 @@ use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::storage::Owned;
 use nalgebra::{DMatrix, DVector, Dyn};
 use rayon::prelude::*;
+use std::sync::atomic::Ordering::Relaxed;
 
 use super::objective::Objective;
 
@@ -35,6 +36,9 @@ struct Problem<'a, 'b> {
     theta: DVector<f64>,
     residuals: Option<DVector<f64>>,
     evaluations: usize,
+    /// Jacobians computed so far, and the most allowed (each costs one run per free parameter).
+    jacobians: std::sync::atomic::AtomicUsize,
+    max_jacobians: usize,
 }
 
 fn unit_of_theta(theta: &[f64]) -> Vec<f64> {
@@ -70,6 +74,11 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
+        // Out of budget: stop at the last accepted point (the solver reports `User("jacobian")`).
+        if self.jacobians.load(Relaxed) >= self.max_jacobians {
+            return None;
+        }
+        self.jacobians.fetch_add(1, Relaxed);
         let base = self.residuals.as_ref()?;
         let n = self.theta.len();
         let cols: Vec<Option<Vec<f64>>> = (0..n)
@@ -96,26 +105,36 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
     }
 }
 
-/// Levenberg–Marquardt from `start` (a full parameter vector), at most about
-/// `max_evaluations` residual evaluations (Jacobians not counted).
-pub fn minimize(obj: &Objective<'_>, start: &[f64], max_evaluations: usize) -> LocalFit {
+/// Levenberg–Marquardt from `start` (a full parameter vector), with at most
+/// `max_iterations` Jacobians (iterations) and about `10·max_iterations` further residual
+/// evaluations. Stops earlier when the relative decrease of the cost or the step falls
+/// below 1e-7.
+pub fn minimize(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> LocalFit {
     let theta0: Vec<f64> = obj.to_unit(start).iter().map(|s| (2.0 * s - 1.0).clamp(-1.0, 1.0).asin()).collect();
     let n = theta0.len();
     if n == 0 {
         return LocalFit { params: start.to_vec(), cost: obj.cost(start), evaluations: 1, termination: "no free parameters".into() };
     }
-    let mut problem = Problem { obj, theta: DVector::from_vec(theta0.clone()), residuals: None, evaluations: 0 };
+    let mut problem = Problem {
+        obj,
+        theta: DVector::from_vec(theta0.clone()),
+        residuals: None,
+        evaluations: 0,
+        jacobians: std::sync::atomic::AtomicUsize::new(0),
+        max_jacobians: max_iterations.max(1),
+    };
     problem.set_params(&DVector::from_vec(theta0));
-    let patience = (max_evaluations / (n + 1)).max(1);
+    let patience = (10 * max_iterations / (n + 1)).max(1);
     let (problem, report) = LevenbergMarquardt::new()
-        .with_ftol(1e-10)
-        .with_xtol(1e-9)
-        .with_gtol(1e-12)
+        .with_ftol(1e-7)
+        .with_xtol(1e-7)
+        .with_gtol(1e-10)
         .with_patience(patience)
         .minimize(problem);
     let params = obj.from_unit(&unit_of_theta(problem.theta.as_slice()));
     let cost = obj.cost(&params);
-    LocalFit { params, cost, evaluations: problem.evaluations, termination: format!("{:?}", report.termination) }
+    let evaluations = problem.evaluations + problem.jacobians.load(Relaxed) * n;
+    LocalFit { params, cost, evaluations, termination: format!("{:?}", report.termination) }
 }
 
 #[cfg(test)]
@@ -141,13 +160,13 @@ mod tests {
         let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
         let mut y = vec![0.0; kin.len()];
         assert!(sim.run(&truth, &kin, &mut y));
-        let sc = Scales { x_mean: 0.0, x: 0.8, dx: 1.5, ddx: 4.0, y_mean: 0.0, y: 2.0, u: None };
-        let sp = spec("bouc_wen", &sc, None).unwrap();
+        let sc = Scales { x_mean: 0.0, x: 0.8, dx: 1.5, ddx: 4.0, y_mean: 0.0, y: 2.0, u: None, fs: 1000.0 };
+        let sp = spec("bouc_wen", &sc, Some(RateChoice::Backward)).unwrap();
         let rows: Vec<usize> = (0..kin.len()).collect();
         let obj = Objective::new(sim.as_ref(), &sp, &kin, &y, &rows, 2.0);
         let start = [2.0, 1.0, 2.0, 1.0, 1.5, 0.2, 0.5, 0.1];
         let before = obj.cost(&start);
-        let fit = minimize(&obj, &start, 400);
+        let fit = minimize(&obj, &start, 100);
         assert!(fit.cost < 1e-8 && fit.cost < before * 1e-4, "{fit:?} (start cost {before})");
         for (got, want) in fit.params.iter().zip(truth) {
             assert!((got - want).abs() < 1e-2 * (1.0 + want.abs()), "{:?}", fit.params);

@@ -69,7 +69,8 @@ pub struct Dataset {
     pub command: Option<Vec<f64>>,
     /// First held-out sample.
     pub train_end: usize,
-    /// Samples the quality checks flagged (excluded from the fit and from the scores).
+    /// Samples the quality checks flagged: excluded from the fit (the model still runs
+    /// through them) and scored separately.
     pub excluded: Vec<bool>,
 }
 
@@ -126,8 +127,8 @@ impl Dataset {
         (0..self.train_end).filter(|&i| !self.excluded.get(i).copied().unwrap_or(false)).collect()
     }
 
-    /// Held-out samples that are scored.
-    pub fn heldout_rows(&self) -> Vec<usize> {
+    /// Held-out samples the quality checks did not flag.
+    pub fn heldout_unflagged(&self) -> Vec<usize> {
         (self.train_end..self.len()).filter(|&i| !self.excluded.get(i).copied().unwrap_or(false)).collect()
     }
 
@@ -154,6 +155,7 @@ impl Dataset {
             y_mean,
             y: ys,
             u: u.filter(|u| *u > 0.0),
+            fs: 1.0 / self.dt,
         }
     }
 }
@@ -167,13 +169,14 @@ pub struct FitOptions {
     /// Samples of the training part the swarm scores (the start of it), to keep the global
     /// phase cheap; Levenberg–Marquardt then uses the whole training part.
     pub swarm_window: usize,
-    /// Residual evaluations allowed to each Levenberg–Marquardt run.
-    pub lm_evaluations: usize,
+    /// Iterations (Jacobians) allowed to the final Levenberg–Marquardt run on the whole
+    /// training part; the polishing runs on the swarm's window get the same number.
+    pub lm_iterations: usize,
 }
 
 impl Default for FitOptions {
     fn default() -> Self {
-        Self { rate: None, swarm: SwarmOptions::default(), swarm_window: 15_000, lm_evaluations: 400 }
+        Self { rate: None, swarm: SwarmOptions::default(), swarm_window: 9_000, lm_iterations: 15 }
     }
 }
 
@@ -183,11 +186,13 @@ pub struct FitResult {
     pub model: String,
     /// Fitted parameters by name (blocks as arrays).
     pub params: Values,
+    /// On the training samples the fit used (flagged ones left out).
     pub train: Metrics,
+    /// On every held-out sample.
     pub heldout: Metrics,
-    /// Held-out metrics including the flagged samples, when some were flagged.
+    /// On the held-out samples the quality checks did not flag, when some were flagged.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub heldout_with_flagged: Option<Metrics>,
+    pub heldout_unflagged: Option<Metrics>,
     pub fit_seconds: f64,
     pub method: Strategy,
     /// Rate estimator used (`backward`, `filtered:FC`, `kalman:Q:R`).
@@ -204,6 +209,8 @@ pub struct FitResult {
     /// Flat parameter vector (registry order).
     #[serde(skip)]
     pub flat: Vec<f64>,
+    #[serde(skip)]
+    pub rate_choice: RateChoice,
     /// The replayed output over the whole recording.
     #[serde(skip)]
     pub output: Vec<f64>,
@@ -245,7 +252,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         let pick = |v: &[f64]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
         metrics(&pick(&data.output), &pick(&output), Some((&pick(&dx), &pick(&ddx))))
     };
-    let heldout_rows = data.heldout_rows();
+    let unflagged = data.heldout_unflagged();
     if std::env::var_os("HIL_SIM_DEBUG").is_some() {
         let mut seg = Vec::new();
         let mut a = data.train_end;
@@ -264,8 +271,8 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         model: id.to_owned(),
         params: named,
         train: score(&rows),
-        heldout: score(&heldout_rows),
-        heldout_with_flagged: (heldout_rows.len() != all_heldout.len()).then(|| score(&all_heldout)),
+        heldout: score(&all_heldout),
+        heldout_unflagged: (unflagged.len() != all_heldout.len()).then(|| score(&unflagged)),
         fit_seconds,
         method: sp.strategy,
         rate: rate_name(sp.rate),
@@ -276,6 +283,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         state_bytes: info.state_bytes,
         held: rep.held,
         flat: params,
+        rate_choice: sp.rate,
         output,
     })
 }
@@ -302,11 +310,11 @@ fn identify(
             }
             // A sign bound is active: continue from the box-clamped solution under LM.
             let clamped: Vec<f64> = p.iter().zip(&sp.params).map(|(v, ps)| v.clamp(ps.lo, ps.hi)).collect();
-            let r = lm::minimize(&full, &clamped, opts.lm_evaluations);
+            let r = lm::minimize(&full, &clamped, opts.lm_iterations);
             valid_or_err(id, sim, r.params, r.evaluations + 1)
         }
         Strategy::Local => {
-            let r = lm::minimize(&full, &sp.start(), opts.lm_evaluations);
+            let r = lm::minimize(&full, &sp.start(), opts.lm_iterations);
             valid_or_err(id, sim, r.params, r.evaluations)
         }
         Strategy::Global => {
@@ -322,7 +330,7 @@ fn identify(
             // Polish every candidate on the window, then the best on the whole training part.
             let mut best: Option<lm::LocalFit> = None;
             for c in &cands {
-                let r = lm::minimize(&win, &c.params, opts.lm_evaluations / 2);
+                let r = lm::minimize(&win, &c.params, opts.lm_iterations);
                 evals += r.evaluations;
                 if std::env::var_os("HIL_SIM_DEBUG").is_some() {
                     eprintln!("{id}: window LM {} -> {} ({} evals, {})", c.cost, r.cost, r.evaluations, r.termination);
@@ -332,7 +340,7 @@ fn identify(
                 }
             }
             let start = best.map(|b| b.params).ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
-            let r = lm::minimize(&full, &start, opts.lm_evaluations);
+            let r = lm::minimize(&full, &start, opts.lm_iterations);
             evals += r.evaluations;
             if std::env::var_os("HIL_SIM_DEBUG").is_some() {
                 eprintln!("{id}: full LM -> {} ({} evals, {}) {:?}", r.cost, r.evaluations, r.termination, r.params);
