@@ -2,11 +2,14 @@
 //! accuracy checks of the fixed-step core.
 
 pub mod accuracy;
+pub mod closed_loop;
 pub mod data;
 pub mod dispatch;
 pub mod excitation;
 pub mod metrics;
 pub mod params_file;
+pub mod plant;
 pub mod recording;
 pub mod reference;
 pub mod replay;
+pub mod scenario;

@@ -80,7 +80,13 @@ mod tests {
     use super::*;
 
     fn cal() -> Calibration {
-        Calibration { samples: 4, max_spread: 6, nominal_hall: 2048.0, nominal_current: 2048.0, max_offset_error: 100.0 }
+        Calibration {
+            samples: 4,
+            max_spread: 6,
+            nominal_hall: 2048.0,
+            nominal_current: 2048.0,
+            max_offset_error: 100.0,
+        }
     }
 
     #[test]

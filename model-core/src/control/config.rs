@@ -108,8 +108,8 @@ pub struct ControlConfig {
     pub open_v: f32,
     pub open_i: f32,
     pub open_samples: f32,
-    /// Largest plausible Hall change per sample, T; `slew_count` violations within 8
-    /// samples trip the noise check.
+    /// Largest plausible Hall change per sample, T; `slew_count` jumps beyond it that
+    /// reverse the previous jump, within 8 samples, trip the noise check.
     pub b_slew_max: f32,
     pub slew_count: f32,
     /// The Hall counts repeating unchanged this many times is a stuck sensor (0 disables).
@@ -377,9 +377,8 @@ impl ValidatedConfig {
         if stored != computed {
             return Err(ConfigError::CrcMismatch { stored, computed });
         }
-        let cfg = ControlConfig::from_words(words).ok_or(ConfigError::Invalid(ParamError::Constraint {
-            what: "unknown loop mode",
-        }))?;
+        let cfg = ControlConfig::from_words(words)
+            .ok_or(ConfigError::Invalid(ParamError::Constraint { what: "unknown loop mode" }))?;
         cfg.validate().map_err(ConfigError::Invalid)
     }
     /// Fault injection: flip one bit of the RAM copy (as a radiation upset or a stray

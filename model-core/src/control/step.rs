@@ -193,7 +193,8 @@ impl<M: Model> ControlStep<M> {
                 return out;
             }
             Mode::Calibrating => {
-                let obs = Observation { hall: x.hall, b, i, supply_v: x.supply_v, running: false, ..Default::default() };
+                let obs =
+                    Observation { hall: x.hall, b, i, supply_v: x.supply_v, running: false, ..Default::default() };
                 let code = check(c, &mut s.sup, &obs);
                 if code != FaultCode::None {
                     return self.trip(s, out, code);
@@ -396,9 +397,8 @@ mod tests {
         assert_eq!(s.mode, Mode::Running);
         cfg.inject_bit_flip(700);
         let passes = super::super::config::WORDS.div_ceil(super::super::config::SCRUB_WORDS);
-        let tripped = (0..2 * passes)
-            .map(|k| step.step(&cfg, &mut s, input(k as u16)))
-            .any(|o| o.fault == FaultCode::ConfigCrc);
+        let tripped =
+            (0..2 * passes).map(|k| step.step(&cfg, &mut s, input(k as u16))).any(|o| o.fault == FaultCode::ConfigCrc);
         assert!(tripped);
     }
 
@@ -412,13 +412,7 @@ mod tests {
     }
 
     fn any_input() -> impl Strategy<Value = ControlInput> {
-        let f = prop_oneof![
-            any::<f32>(),
-            Just(f32::NAN),
-            Just(f32::INFINITY),
-            Just(f32::NEG_INFINITY),
-            -30.0f32..30.0
-        ];
+        let f = prop_oneof![any::<f32>(), Just(f32::NAN), Just(f32::INFINITY), Just(f32::NEG_INFINITY), -30.0f32..30.0];
         (any::<u16>(), any::<u16>(), f.clone(), f.clone(), f, any::<[bool; 3]>()).prop_map(
             |(hall, current, supply_v, reference, temperature, [overrun, enable, reset])| ControlInput {
                 hall: hall % 4096,

@@ -107,6 +107,8 @@ pub struct SupState {
     pub band: u16,
     /// Slew violations of the last 8 samples, one bit each.
     pub slew_hist: u8,
+    /// Last Hall change that exceeded the slew limit, T.
+    pub last_jump: f32,
     pub last_hall: u16,
     pub last_b: f32,
     pub primed: bool,
@@ -131,7 +133,15 @@ pub fn check(cfg: &ControlConfig, s: &mut SupState, o: &Observation) -> FaultCod
     let over = count(&mut s.over, !o.i.is_finite() || abs(o.i) > cfg.over_current) >= confirm;
     let model = count(&mut s.model, o.running && o.model_bad) >= confirm;
     let overrun = count(&mut s.overrun, o.overrun) >= confirm;
-    let slew = s.primed && abs(o.b - s.last_b) > cfg.b_slew_max;
+    // Noise reverses direction; a real field change (even a collapse when the coil
+    // opens) moves one way. A violation is a jump beyond the slew limit that reverses the
+    // previous one.
+    let db = o.b - s.last_b;
+    let big = s.primed && abs(db) > cfg.b_slew_max;
+    let slew = big && db * s.last_jump < 0.0;
+    if big {
+        s.last_jump = db;
+    }
     s.slew_hist = (s.slew_hist << 1) | u8::from(slew && o.running);
     let noise = s.slew_hist.count_ones() >= cfg.slew_count as u32;
     let frozen = s.primed && o.hall == s.last_hall && o.running;
@@ -177,7 +187,15 @@ mod tests {
     use super::*;
 
     fn ok_obs(k: u16) -> Observation {
-        Observation { hall: 2048 + k % 3, b: 0.1, i: 0.5, supply_v: 24.0, v_applied: 2.0, running: true, ..Default::default() }
+        Observation {
+            hall: 2048 + k % 3,
+            b: 0.1,
+            i: 0.5,
+            supply_v: 24.0,
+            v_applied: 2.0,
+            running: true,
+            ..Default::default()
+        }
     }
 
     fn run(cfg: &ControlConfig, f: impl Fn(u16) -> Observation) -> (FaultCode, u16) {
@@ -202,7 +220,11 @@ mod tests {
         assert_eq!(run(&cfg, |k| Observation { hall: 0, ..ok_obs(k) }), (FaultCode::HallShort, 3));
         assert_eq!(run(&cfg, |k| Observation { hall: 2100, ..ok_obs(k) }), (FaultCode::HallStuck, 13));
         let noisy = |k: u16| Observation { b: if k.is_multiple_of(2) { 0.3 } else { -0.2 }, ..ok_obs(k) };
-        assert_eq!(run(&cfg, noisy), (FaultCode::HallNoise, 3));
+        // The first jump has no earlier one to reverse: the third reversal is the 4th sample.
+        assert_eq!(run(&cfg, noisy), (FaultCode::HallNoise, 4));
+        // A one-way collapse of the field (coil opened) is not noise.
+        let collapse = |k: u16| Observation { b: 0.1 - 0.05 * f32::from(k.min(2)), ..ok_obs(k) };
+        assert_eq!(run(&cfg, collapse).0, FaultCode::None);
         assert_eq!(run(&cfg, |k| Observation { i: 0.0, v_applied: 10.0, ..ok_obs(k) }), (FaultCode::CoilOpen, 10));
         assert_eq!(run(&cfg, |k| Observation { i: 9.0, ..ok_obs(k) }), (FaultCode::OverCurrent, 3));
         assert_eq!(run(&cfg, |k| Observation { supply_v: 12.0, ..ok_obs(k) }), (FaultCode::SupplyLow, 3));
