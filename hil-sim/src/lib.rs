@@ -2,16 +2,20 @@
 //! accuracy checks of the fixed-step core.
 
 pub mod accuracy;
+pub mod closed_loop;
 pub mod compare;
 pub mod data;
 pub mod dispatch;
 pub mod excitation;
 pub mod fit;
+pub mod fit_report;
 pub mod metrics;
 pub mod params_file;
-pub mod quality;
+pub mod plant;
 pub mod plot;
+pub mod quality;
 pub mod recording;
 pub mod reference;
 pub mod replay;
 pub mod report;
+pub mod scenario;

@@ -11,6 +11,7 @@
 //! non-finite values (see [`Estimator::step`] for the exact rule).
 #![cfg_attr(not(test), no_std)]
 
+pub mod control;
 pub mod error;
 pub mod estimator;
 pub mod kinematics;

@@ -4,8 +4,10 @@
 mod accuracy;
 mod demo;
 mod fit;
+mod loop_cmd;
 mod models;
 mod replay;
+mod simulate;
 
 use std::path::PathBuf;
 
@@ -33,6 +35,10 @@ pub enum Cmd {
     Accuracy(accuracy::AccuracyArgs),
     /// The main job on the bundled data (see README).
     Demo(demo::DemoArgs),
+    /// Write a recording of the simulated MR clutch (`t,b,torque,i,…`).
+    Simulate(simulate::SimulateArgs),
+    /// Closed loop: the firmware's control step against the simulated clutch.
+    Loop(loop_cmd::LoopArgs),
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
@@ -42,6 +48,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Cmd::Fit(a) => fit::run(a),
         Cmd::Accuracy(a) => accuracy::run(a),
         Cmd::Demo(a) => demo::run(a),
+        Cmd::Simulate(a) => simulate::run_cmd(a),
+        Cmd::Loop(a) => loop_cmd::run_cmd(a),
     }
 }
 

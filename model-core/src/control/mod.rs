@@ -1,0 +1,23 @@
+//! The firmware's per-sample control step and its parts, `no_std`, f32, no allocation.
+//!
+//! Signal path of [`step::ControlStep::step`], one call per ADC interrupt:
+//! ADC counts → B and coil current ([`calibration`]) → rate and torque estimate
+//! ([`Estimator`](crate::Estimator), any model) → torque PI with anti-windup ([`pi`]) plus the
+//! feed-forward from the inverse of the model's static part ([`feedforward`]) → coil current
+//! PI → H-bridge duty with the demagnetising pulse ([`pwm`]). The [`supervisor`] checks every
+//! sample for implausible readings and latches a fault code; any fault ends in the safe
+//! state (PWM off, bridge high-impedance so the coil de-energises through the diodes).
+//! Settings are a [`config::ValidatedConfig`]: validated once, CRC-protected, swapped in
+//! between samples by replacing a `Copy` value.
+
+pub mod calibration;
+pub mod config;
+pub mod feedforward;
+pub mod pi;
+pub mod pwm;
+pub mod step;
+pub mod supervisor;
+
+pub use config::{ControlConfig, LoopMode, ValidatedConfig};
+pub use step::{ControlInput, ControlOutput, ControlState, ControlStep, Mode};
+pub use supervisor::FaultCode;

@@ -1,0 +1,88 @@
+//! PI controller with output limits and clamping anti-windup (conditional integration,
+//! Åström & Hägglund, *Advanced PID Control*, 2006, §3.5).
+//!
+//! `u = ff + kp·e + I`, `I ← I + ki·T·e` only while the output is not saturated in the
+//! direction `e` pushes it; `I` is kept within the output limits.
+
+/// Validated gains and limits (built by [`Pi::new`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pi {
+    kp: f32,
+    ki_dt: f32,
+    lo: f32,
+    hi: f32,
+}
+
+/// Integrator state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PiState {
+    pub integral: f32,
+}
+
+impl Pi {
+    /// Gains `kp`, `ki` (per second) at time step `dt`, output limited to `[lo, hi]`.
+    /// Callers validate the numbers (see [`ControlConfig::validate`](super::ControlConfig::validate)).
+    pub const fn new(kp: f32, ki: f32, dt: f32, lo: f32, hi: f32) -> Self {
+        Self { kp, ki_dt: ki * dt, lo, hi }
+    }
+
+    /// One step with error `e` and feed-forward `ff`; returns the limited output.
+    /// A non-finite `e` leaves the state unchanged; a non-finite `ff` counts as 0.
+    #[inline]
+    pub fn step(&self, s: &mut PiState, e: f32, ff: f32) -> f32 {
+        let ff = if ff.is_finite() { ff } else { 0.0 };
+        if !e.is_finite() {
+            return clamp(ff + s.integral, self.lo, self.hi);
+        }
+        let raw = ff + self.kp * e + s.integral;
+        let out = clamp(raw, self.lo, self.hi);
+        let pushes_out = (raw > self.hi && e > 0.0) || (raw < self.lo && e < 0.0);
+        if !pushes_out {
+            let i = s.integral + self.ki_dt * e;
+            s.integral = clamp(i, self.lo - ff, self.hi - ff);
+        }
+        out
+    }
+}
+
+/// `x` limited to `[lo, hi]`; NaN maps to `lo`.
+#[inline]
+pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
+    if x >= hi {
+        hi
+    } else if x >= lo {
+        x
+    } else {
+        lo
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn integrates_and_stops_at_the_limit() {
+        let pi = Pi::new(1.0, 100.0, 0.01, -2.0, 2.0);
+        let mut s = PiState::default();
+        let u1 = pi.step(&mut s, 1.0, 0.0);
+        assert!((u1 - 1.0).abs() < 1e-6 && (s.integral - 1.0).abs() < 1e-6);
+        for _ in 0..100 {
+            assert!(pi.step(&mut s, 1.0, 0.0) <= 2.0);
+        }
+        let wound = s.integral;
+        assert!(wound <= 2.0, "integral {wound}");
+        // Anti-windup: a sign change of the error leaves saturation at once.
+        let u = pi.step(&mut s, -1.0, 0.0);
+        assert!(u < 2.0, "{u}");
+    }
+
+    #[test]
+    fn nan_is_harmless() {
+        let pi = Pi::new(1.0, 1.0, 0.01, -1.0, 1.0);
+        let mut s = PiState::default();
+        assert_eq!(pi.step(&mut s, f32::NAN, f32::NAN), 0.0);
+        assert_eq!(s, PiState::default());
+        assert_eq!(clamp(f32::NAN, -1.0, 1.0), -1.0);
+    }
+}

@@ -1,0 +1,88 @@
+//! Duty of a bipolar H-bridge and the demagnetising pulse.
+//!
+//! `d = V/V_supply`, limited to `±duty_max` and quantised to the timer's compare counts
+//! (sign-magnitude drive: the sign selects the diagonal, `|d|` the on-time). When the
+//! command returns to zero after a large value, a short reverse pulse drives the core
+//! round a minor loop towards B = 0, removing most of the remanent field and with it the
+//! remanent torque (the usual degaussing practice for MR clutches, e.g. Shafer &
+//! Kermani's clutch, seed 000 ref. 20).
+
+use super::pi::clamp;
+
+/// Duty in `[−duty_max, duty_max]` for voltage `v` at supply `supply` (V), quantised to
+/// `counts`; returns `(duty, compare)`. A non-finite `v` or supply, or a non-positive
+/// supply, gives 0.
+#[inline]
+pub fn duty(v: f32, supply: f32, duty_max: f32, counts: f32) -> (f32, i32) {
+    if !(supply.is_finite() && supply > 0.0 && v.is_finite()) {
+        return (0.0, 0);
+    }
+    let d = clamp(v / supply, -duty_max, duty_max);
+    let compare = libm::roundf(d * counts);
+    (compare / counts, compare as i32)
+}
+
+/// Demagnetising pulse settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Demag {
+    pub duty: f32,
+    pub samples: u16,
+    /// |command| that arms the pulse; it fires when |command| falls below a quarter of it.
+    pub threshold: f32,
+}
+
+/// Pulse state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DemagState {
+    pub armed: bool,
+    pub remaining: u16,
+    /// Sign of the current before the pulse.
+    pub sign: f32,
+}
+
+impl Demag {
+    /// Feed the command and the coil current; `Some(duty)` while the pulse overrides the loop.
+    pub fn step(&self, s: &mut DemagState, command: f32, i: f32) -> Option<f32> {
+        if s.remaining > 0 {
+            s.remaining -= 1;
+            return Some(-s.sign * self.duty);
+        }
+        let mag = crate::math::abs(command);
+        if mag >= self.threshold {
+            s.armed = true;
+            s.sign = if i < 0.0 { -1.0 } else { 1.0 };
+        } else if s.armed && mag < 0.25 * self.threshold {
+            s.armed = false;
+            if self.samples > 0 {
+                s.remaining = self.samples - 1;
+                return Some(-s.sign * self.duty);
+            }
+        }
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn duty_limits_and_quantises() {
+        assert_eq!(duty(12.0, 24.0, 0.95, 1000.0), (0.5, 500));
+        assert_eq!(duty(100.0, 24.0, 0.95, 1000.0), (0.95, 950));
+        assert_eq!(duty(-0.01234, 1.0, 0.95, 1000.0), (-0.012, -12));
+        assert_eq!(duty(1.0, 0.0, 0.95, 1000.0), (0.0, 0));
+        assert_eq!(duty(f32::NAN, 24.0, 0.95, 1000.0), (0.0, 0));
+    }
+
+    #[test]
+    fn pulse_after_the_command_returns_to_zero() {
+        let d = Demag { duty: 0.5, samples: 3, threshold: 1.0 };
+        let mut s = DemagState::default();
+        assert_eq!(d.step(&mut s, 0.0, 0.0), None, "not armed yet");
+        assert_eq!(d.step(&mut s, 5.0, 2.0), None);
+        assert_eq!(d.step(&mut s, 0.5, 1.0), None, "above a quarter of the threshold");
+        let pulse: Vec<_> = (0..5).map(|_| d.step(&mut s, 0.0, 1.0)).collect();
+        assert_eq!(pulse, vec![Some(-0.5), Some(-0.5), Some(-0.5), None, None]);
+    }
+}
