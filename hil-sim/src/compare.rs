@@ -210,9 +210,9 @@ impl Comparison {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dispatch::RateChoice;
     use crate::excitation::Excitation;
     use crate::fit::simulate::{kinematics, simulator};
-    use crate::dispatch::RateChoice;
     use crate::recording::{Column, Recording};
     use crate::replay::Channels;
     use std::path::Path;

@@ -32,6 +32,9 @@ pub struct FitArgs {
     /// Write each fitted set as `<DIR>/<model>.json` (a `replay --params` file).
     #[arg(long)]
     pub save: Option<PathBuf>,
+    /// Write a report (report.md, index.html and SVG plots of the best model) to this folder.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
 }
@@ -105,6 +108,11 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
         .filter(|r| r.heldout.rmse.is_finite())
         .min_by(|x, y| x.heldout.rmse.total_cmp(&y.heldout.rmse))
         .map(|r| r.model.clone());
+    if let Some(dir) = &a.out {
+        let title = format!("Fit of {}", path.display());
+        let index = write_report(dir, &title, &data, &results, &a.ch.input, &a.ch.output)?;
+        eprintln!("report written to {}", index.display());
+    }
     if a.json {
         return super::print_json(&json!({
             "recording": path.display().to_string(),
@@ -158,4 +166,36 @@ pub fn table(results: &[FitResult]) -> String {
         );
     }
     s
+}
+
+/// Write a fit report: the table, the error bars, and the plots of the best model (by
+/// held-out RMSE). Returns the path of `index.html`.
+pub fn write_report(
+    dir: &std::path::Path,
+    title: &str,
+    data: &Dataset,
+    results: &[FitResult],
+    input: &str,
+    output: &str,
+) -> anyhow::Result<PathBuf> {
+    use hil_sim::fit_report::{error_bars, fit_plots, results_table, Labels};
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let mut rep = hil_sim::report::Report::new(title);
+    rep.paragraph(&format!(
+        "{} samples at {:.1} Hz; fitted on the first {} samples, scored on the last {}. Metrics are from the \
+         f32 replay through model-core (the firmware's code), one step per sample.",
+        data.len(),
+        1.0 / data.dt,
+        data.train_end,
+        data.len() - data.train_end
+    ));
+    results_table(&mut rep, results);
+    let stem = |m: &str| format!("fit_{m}");
+    error_bars(&mut rep, dir, "fit", results)?;
+    let labels = Labels { input: input.to_owned(), output: output.to_owned() };
+    if let Some(best) = results.iter().min_by(|x, y| x.heldout.rmse.total_cmp(&y.heldout.rmse)) {
+        rep.heading(&format!("Best held-out model: {}", best.model));
+        fit_plots(&mut rep, dir, &stem(&best.model), data, best, &labels)?;
+    }
+    Ok(rep.write(dir)?)
 }

@@ -2,6 +2,7 @@
 //! then stdout carries exactly one JSON object; progress and logs go to stderr.
 
 mod accuracy;
+mod compare;
 mod demo;
 mod fit;
 mod loop_cmd;
@@ -31,6 +32,8 @@ pub enum Cmd {
     Replay(replay::ReplayArgs),
     /// Identify model parameters on the first part of a recording and score the rest.
     Fit(fit::FitArgs),
+    /// Seed 000's protocol: fit per recording, average the parameters, validate elsewhere.
+    Compare(compare::CompareArgs),
     /// Check the f32 fixed-step core against f64 adaptive-step references.
     Accuracy(accuracy::AccuracyArgs),
     /// The main job on the bundled data (see README).
@@ -46,6 +49,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Cmd::Models(a) => models::run(a),
         Cmd::Replay(a) => replay::run(a),
         Cmd::Fit(a) => fit::run(a),
+        Cmd::Compare(a) => compare::run(a),
         Cmd::Accuracy(a) => accuracy::run(a),
         Cmd::Demo(a) => demo::run(a),
         Cmd::Simulate(a) => simulate::run_cmd(a),

@@ -11,7 +11,15 @@ use nalgebra::{DMatrix, DVector};
 /// Regressor row of model `id` at one sample (`None` for a model that is not linear).
 pub fn regressors(id: &str, k: &Kin) -> Option<Vec<f64>> {
     let (x, dx, u) = (f64::from(k.x), f64::from(k.dx), f64::from(k.u));
-    let sgn = |v: f64| if v > 0.0 { 1.0 } else if v < 0.0 { -1.0 } else { 0.0 };
+    let sgn = |v: f64| {
+        if v > 0.0 {
+            1.0
+        } else if v < 0.0 {
+            -1.0
+        } else {
+            0.0
+        }
+    };
     Some(match id {
         // T = k·B + c·Ḃ + α·|B|·B³ + T₀
         "algebraic" => vec![x, dx, x.abs() * x.powi(3), 1.0],
@@ -94,8 +102,10 @@ mod tests {
     fn recovers_exact_parameters_and_respects_fixed_ones() {
         let k = kin(2000);
         let truth = vec![2.0, 0.3, -1.5, 0.7];
-        let y: Vec<f64> =
-            k.iter().map(|kk| regressors("algebraic", kk).unwrap().iter().zip(&truth).map(|(a, b)| a * b).sum()).collect();
+        let y: Vec<f64> = k
+            .iter()
+            .map(|kk| regressors("algebraic", kk).unwrap().iter().zip(&truth).map(|(a, b)| a * b).sum())
+            .collect();
         let rows: Vec<usize> = (0..k.len()).collect();
         let got = solve("algebraic", &k, &y, &rows, &[0, 1, 2, 3], &[0.0; 4]).unwrap();
         for (g, t) in got.iter().zip(&truth) {

@@ -113,7 +113,12 @@ pub fn minimize(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> Lo
     let theta0: Vec<f64> = obj.to_unit(start).iter().map(|s| (2.0 * s - 1.0).clamp(-1.0, 1.0).asin()).collect();
     let n = theta0.len();
     if n == 0 {
-        return LocalFit { params: start.to_vec(), cost: obj.cost(start), evaluations: 1, termination: "no free parameters".into() };
+        return LocalFit {
+            params: start.to_vec(),
+            cost: obj.cost(start),
+            evaluations: 1,
+            termination: "no free parameters".into(),
+        };
     }
     let mut problem = Problem {
         obj,
@@ -140,9 +145,9 @@ pub fn minimize(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> Lo
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dispatch::RateChoice;
     use crate::fit::simulate::{kinematics, simulator};
     use crate::fit::spec::{spec, Scales};
-    use crate::dispatch::RateChoice;
     use model_core::Sample;
 
     /// Recover a Bouc–Wen parameter set from its own noiseless output, starting away from it.

@@ -253,17 +253,6 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         metrics(&pick(&data.output), &pick(&output), Some((&pick(&dx), &pick(&ddx))))
     };
     let unflagged = data.heldout_unflagged();
-    if std::env::var_os("HIL_SIM_DEBUG").is_some() {
-        let mut seg = Vec::new();
-        let mut a = data.train_end;
-        while a < data.len() {
-            let b = (a + 1000).min(data.len());
-            let r: Vec<usize> = (a..b).collect();
-            seg.push(format!("{:.1}s:{:.0}", data.time.get(a).copied().unwrap_or(0.0), score(&r).rmse));
-            a = b;
-        }
-        eprintln!("{id}: held-out RMSE per 1000 samples: {}", seg.join(" "));
-    }
     let all_heldout: Vec<usize> = (data.train_end..data.len()).collect();
     let flat32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
     let named = ParamsFile::from_flat(id, None, &flat32).map(|f| f.params).unwrap_or(Values::Flat(params.clone()));
@@ -324,17 +313,11 @@ fn identify(
             let cands = global::search(&win, opts.swarm)
                 .map_err(|e| FitError::Swarm { model: id.to_owned(), reason: e.to_string() })?;
             let mut evals = opts.swarm.particles * (opts.swarm.iterations as usize + 1);
-            if std::env::var_os("HIL_SIM_DEBUG").is_some() {
-                eprintln!("{id}: swarm {:?}", cands.iter().map(|c| c.cost).collect::<Vec<_>>());
-            }
             // Polish every candidate on the window, then the best on the whole training part.
             let mut best: Option<lm::LocalFit> = None;
             for c in &cands {
                 let r = lm::minimize(&win, &c.params, opts.lm_iterations);
                 evals += r.evaluations;
-                if std::env::var_os("HIL_SIM_DEBUG").is_some() {
-                    eprintln!("{id}: window LM {} -> {} ({} evals, {})", c.cost, r.cost, r.evaluations, r.termination);
-                }
                 if r.cost.is_finite() && best.as_ref().is_none_or(|b| r.cost < b.cost) {
                     best = Some(r);
                 }
@@ -342,9 +325,6 @@ fn identify(
             let start = best.map(|b| b.params).ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
             let r = lm::minimize(&full, &start, opts.lm_iterations);
             evals += r.evaluations;
-            if std::env::var_os("HIL_SIM_DEBUG").is_some() {
-                eprintln!("{id}: full LM -> {} ({} evals, {}) {:?}", r.cost, r.evaluations, r.termination, r.params);
-            }
             valid_or_err(id, sim, r.params, evals)
         }
     }

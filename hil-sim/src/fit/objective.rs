@@ -49,10 +49,7 @@ impl<'a> Objective<'a> {
 
     /// Box positions of the free parameters of `p`.
     pub fn to_unit(&self, p: &[f64]) -> Vec<f64> {
-        self.free
-            .iter()
-            .filter_map(|&j| Some(self.spec.params.get(j)?.to_unit(*p.get(j)?)))
-            .collect()
+        self.free.iter().filter_map(|&j| Some(self.spec.params.get(j)?.to_unit(*p.get(j)?))).collect()
     }
 
     /// Scaled residuals at `p`, `None` when the model rejects `p` or diverges.

@@ -1,0 +1,56 @@
+//! Speed of identification and replay on the real Dyke recording (issue 3, point 2).
+//!
+//! `cargo bench -p hil-sim --bench fit`. Figures to compare with the SciPy baseline in
+//! `scripts/scipy-baseline/` (same model, data and split).
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use hil_sim::dispatch::{replay, RateChoice};
+use hil_sim::fit::{fit, Dataset, FitOptions};
+use hil_sim::recording::Recording;
+use hil_sim::replay::Channels;
+use model_core::Sample;
+
+fn dyke(train: f64, take: Option<usize>) -> Dataset {
+    let path = hil_sim::data::data_file("dyke/ranran_50.csv").expect("bundled data");
+    let mut rec = Recording::read(&path).expect("readable");
+    if let Some(n) = take {
+        for c in &mut rec.columns {
+            c.values.truncate(n);
+        }
+        rec.lines.truncate(n);
+    }
+    let ch = Channels { time: "t".into(), input: "D".into(), output: "F".into(), command: Some("Y".into()) };
+    Dataset::new(&rec, &ch, train, None).expect("dataset")
+}
+
+fn bench(c: &mut Criterion) {
+    // Algebraic model, closed-form least squares on exactly 60,000 training samples.
+    let d60 = dyke(60_000.0 / 74_068.0, None);
+    assert_eq!(d60.train_end, 60_000);
+    let mut g = c.benchmark_group("fit");
+    g.sample_size(20);
+    g.bench_function("algebraic_60k", |b| b.iter(|| fit("algebraic", &d60, &FitOptions::default()).expect("fit")));
+    let d = dyke(0.85, None);
+    g.sample_size(10);
+    g.bench_function("spencer_ranran50_train0.85", |b| {
+        b.iter(|| fit("spencer", &d, &FitOptions::default()).expect("fit"))
+    });
+    g.finish();
+
+    // Replay throughput of the f32 core (Estimator path), one core.
+    let samples: Vec<Sample> = d.samples();
+    let mut g = c.benchmark_group("replay");
+    g.throughput(Throughput::Elements(samples.len() as u64));
+    for (id, p) in [
+        ("algebraic", vec![100.0f32, 20.0, 1.0, -100.0]),
+        ("bouc_wen", vec![500.0, 10.0, 10.0, 1.0, 2.0, 20.0, 5.0, 0.0]),
+    ] {
+        g.bench_function(id, |b| {
+            b.iter(|| replay(id, &p, d.dt as f32, RateChoice::Backward, &samples).expect("replay"))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
