@@ -98,8 +98,8 @@ pub fn compare(
             }
         }
         let flat32: Vec<f32> = flat.iter().map(|v| *v as f32).collect();
-        let valid = model_core::registry::find(id).is_some()
-            && crate::fit::simulate::simulator(id, first_dt(identify) as f32).is_some_and(|s| s.valid(&flat));
+        let valid = crate::fit::simulate::simulator(id, identify.first().map_or(1e-3, |r| r.data.dt) as f32)
+            .is_some_and(|s| s.valid(&flat));
         averaged.push(Averaged {
             model: id.clone(),
             params: ParamsFile::from_flat(id, None, &flat32).map_or(Values::Flat(flat.clone()), |f| f.params),
@@ -128,10 +128,6 @@ pub fn compare(
         }
     }
     Ok(Comparison { fits, averaged, validation })
-}
-
-fn first_dt(recs: &[Named]) -> f64 {
-    recs.first().map_or(1e-3, |r| r.data.dt)
 }
 
 impl Comparison {

@@ -54,17 +54,7 @@ pub fn replay_recording(
     let y = rec.channel(&ch.output)?;
     let u = ch.command.as_deref().map(|c| rec.channel(c)).transpose()?;
     let dt = rec.mean_dt(&ch.time)?;
-    let samples: Vec<Sample> = x
-        .iter()
-        .enumerate()
-        .map(|(i, xv)| {
-            let s = Sample::new(*xv as f32);
-            match u.and_then(|u| u.get(i)) {
-                Some(uv) => s.with_command(*uv as f32),
-                None => s,
-            }
-        })
-        .collect();
+    let samples = samples(x, u);
     let out = replay(model, params, dt as f32, rate, &samples)?;
     let model_output: Vec<f64> = out.y.iter().map(|v| f64::from(*v)).collect();
     // Rates for seed 001's E_x, E_ẋ: central differences of the input.
@@ -80,6 +70,20 @@ pub fn replay_recording(
         measured: y.to_vec(),
         model_output,
     })
+}
+
+/// The samples the core sees: input `x` in f32, with the command `u` when there is one.
+pub fn samples(x: &[f64], u: Option<&[f64]>) -> Vec<Sample> {
+    x.iter()
+        .enumerate()
+        .map(|(i, xv)| {
+            let s = Sample::new(*xv as f32);
+            match u.and_then(|u| u.get(i)) {
+                Some(uv) => s.with_command(*uv as f32),
+                None => s,
+            }
+        })
+        .collect()
 }
 
 /// Central-difference derivative (one-sided at the ends).

@@ -31,6 +31,7 @@ const TRAIN: f64 = 0.85;
 
 struct DykeFit {
     file: &'static str,
+    rec: Recording,
     data: Dataset,
     results: Vec<FitResult>,
     warnings: Vec<String>,
@@ -53,7 +54,7 @@ fn fit_dyke(file: &'static str) -> anyhow::Result<DykeFit> {
     let ids = super::fit::model_list("all")?;
     eprintln!("fitting {} models on {file}", ids.len());
     let results = super::fit::fit_all(&data, &ids, &FitOptions::default())?;
-    Ok(DykeFit { file, data, results, warnings })
+    Ok(DykeFit { file, rec, data, results, warnings })
 }
 
 fn loop_plots(rep: &mut Report, dir: &Path, lp: &Run, bl: &Run) -> anyhow::Result<()> {
@@ -138,9 +139,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     let mut rows = Vec::new();
     let mut replays = Vec::new();
     for f in &fits {
-        let path = hil_sim::data::data_file(f.file).map_err(anyhow::Error::msg)?;
-        let rec = Recording::read(&path)?;
-        let r = replay_recording(&rec, &dyke_channels(), &pf.model, &flat, RateChoice::Backward)?;
+        let r = replay_recording(&f.rec, &dyke_channels(), &pf.model, &flat, RateChoice::Backward)?;
         let m = r.metrics;
         rows.push(vec![
             f.file.to_owned(),

@@ -8,7 +8,6 @@ use hil_sim::fit::{fit, Dataset, FitOptions, FitResult};
 use hil_sim::params_file::ParamsFile;
 use hil_sim::quality;
 use hil_sim::recording::Recording;
-use rayon::prelude::*;
 use serde_json::json;
 
 use super::ChannelArgs;
@@ -93,15 +92,15 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
     let total = t0.elapsed().as_secs_f64();
     if let Some(dir) = &a.save {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        results.par_iter().try_for_each(|r| -> anyhow::Result<()> {
+        for r in &results {
             let flat: Vec<f32> = r.flat.iter().map(|v| *v as f32).collect();
             let mut pf = ParamsFile::from_flat(&r.model, Some(format!("hil-sim fit {}", path.display())), &flat)
                 .context("building the parameter file")?;
             pf.rate = Some(r.rate.clone());
             let file = dir.join(format!("{}.json", r.model));
             std::fs::write(&file, serde_json::to_string_pretty(&pf)? + "\n")
-                .with_context(|| format!("writing {}", file.display()))
-        })?;
+                .with_context(|| format!("writing {}", file.display()))?;
+        }
     }
     let best = results
         .iter()

@@ -109,17 +109,7 @@ impl Dataset {
 
     /// The samples as the core sees them (f32, with the command when there is one).
     pub fn samples(&self) -> Vec<Sample> {
-        self.input
-            .iter()
-            .enumerate()
-            .map(|(i, x)| {
-                let s = Sample::new(*x as f32);
-                match self.command.as_ref().and_then(|u| u.get(i)) {
-                    Some(u) => s.with_command(*u as f32),
-                    None => s,
-                }
-            })
-            .collect()
+        crate::replay::samples(&self.input, self.command.as_deref())
     }
 
     /// Training samples that enter the fit.
