@@ -5,7 +5,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use hil_sim::dispatch::{replay, RateChoice};
-use hil_sim::fit::{fit, Dataset, FitOptions};
+use hil_sim::fit::{fit, Dataset, DelayChoice, FitOptions};
 use hil_sim::recording::Recording;
 use hil_sim::replay::Channels;
 use model_core::Sample;
@@ -29,7 +29,13 @@ fn bench(c: &mut Criterion) {
     assert_eq!(d60.train_end, 60_000);
     let mut g = c.benchmark_group("fit");
     g.sample_size(20);
-    g.bench_function("algebraic_60k", |b| b.iter(|| fit("algebraic", &d60, &FitOptions::default()).expect("fit")));
+    // The closed-form fit itself (channels as recorded), then with the input delay fitted
+    // too (`--delay auto`, the CLI default: one closed-form fit per delay on a grid).
+    let off = FitOptions { delay: DelayChoice::Off, ..FitOptions::default() };
+    g.bench_function("algebraic_60k", |b| b.iter(|| fit("algebraic", &d60, &off).expect("fit")));
+    g.bench_function("algebraic_60k_delay_auto", |b| {
+        b.iter(|| fit("algebraic", &d60, &FitOptions::default()).expect("fit"))
+    });
     let d = dyke(0.85, None);
     g.sample_size(10);
     g.bench_function("spencer_ranran50_train0.85", |b| {

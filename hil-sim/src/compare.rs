@@ -10,7 +10,7 @@
 use serde::Serialize;
 
 use crate::dispatch::replay;
-use crate::fit::{fit, Dataset, FitError, FitOptions, FitResult};
+use crate::fit::{fit, Dataset, DelayChoice, FitError, FitOptions, FitResult};
 use crate::metrics::{metrics, Metrics};
 use crate::params_file::{ParamsFile, Values};
 
@@ -66,7 +66,9 @@ pub struct Comparison {
     pub validation: Vec<Validation>,
 }
 
-/// Run the protocol. `progress` is called once per finished fit.
+/// Run the protocol. `progress` is called once per finished fit. The channels are taken as
+/// recorded (no fitted delay, whatever `opts.delay` says): parameters are averaged across
+/// recordings, and a per-recording alignment has no average that means anything.
 pub fn compare(
     identify: &[Named],
     validate: &[Named],
@@ -74,6 +76,7 @@ pub fn compare(
     opts: &FitOptions,
     mut progress: impl FnMut(&str, &str),
 ) -> Result<Comparison, FitError> {
+    let opts = &FitOptions { delay: DelayChoice::Off, ..*opts };
     let mut fits = Vec::new();
     let mut averaged = Vec::new();
     for id in models {

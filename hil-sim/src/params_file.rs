@@ -50,6 +50,13 @@ pub struct ParamsFile {
     /// Rate estimator the set was fitted with (`--rate` syntax); replay uses it by default.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rate: Option<String>,
+    /// Input delay the set was fitted with, seconds: replay feeds the model `x(t + delay_s)`
+    /// (see `hil_sim::alignment`). Absent means 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub delay_s: Option<f64>,
+    /// Command delay, seconds: replay feeds the model `u(t + command_delay_s)`. Absent means 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub command_delay_s: Option<f64>,
     pub params: Values,
 }
 
@@ -118,7 +125,14 @@ impl ParamsFile {
             let v: Vec<f64> = it.by_ref().take(len).collect();
             map.insert(key.to_owned(), if len == 1 { Value::One(*v.first()?) } else { Value::Block(v) });
         }
-        Some(Self { model: model.to_owned(), source, rate: None, params: Values::Named(map) })
+        Some(Self {
+            model: model.to_owned(),
+            source,
+            rate: None,
+            delay_s: None,
+            command_delay_s: None,
+            params: Values::Named(map),
+        })
     }
 }
 

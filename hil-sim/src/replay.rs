@@ -41,30 +41,38 @@ pub struct ReplayReport {
     pub model_output: Vec<f64>,
 }
 
-/// Replay `rec` through `model` with flat `params`; errors are one line of text.
+/// Replay `rec` through `model` with flat `params`, the input and the command read
+/// `delays_s` later ([`crate::alignment`]; 0 for none); errors are one line of text.
 pub fn replay_recording(
     rec: &Recording,
     ch: &Channels,
     model: &str,
     params: &[f32],
     rate: RateChoice,
+    delays_s: (f64, f64),
 ) -> anyhow::Result<ReplayReport> {
     let t = rec.time(&ch.time)?;
     let x = rec.channel(&ch.input)?;
     let y = rec.channel(&ch.output)?;
     let u = ch.command.as_deref().map(|c| rec.channel(c)).transpose()?;
     let dt = rec.mean_dt(&ch.time)?;
-    let samples = samples(x, u);
+    let (d, d_u) = (delays_s.0 / dt, if u.is_some() { delays_s.1 / dt } else { 0.0 });
+    let x = crate::alignment::shift(x, d);
+    let u = u.map(|u| crate::alignment::shift(u, d_u));
+    let samples = samples(&x, u.as_deref());
     let out = replay(model, params, dt as f32, rate, &samples)?;
     let model_output: Vec<f64> = out.y.iter().map(|v| f64::from(*v)).collect();
     // Rates for seed 001's E_x, E_ẋ: central differences of the input.
-    let dx = gradient(x, dt);
+    let dx = gradient(&x, dt);
     let ddx = gradient(&dx, dt);
+    // Samples whose shifted channels read past the recording's ends are not scored.
+    let (lo, hi) = crate::alignment::covered(x.len(), &[d, d_u]);
+    let part = |v: &[f64]| v.get(lo..hi).unwrap_or(&[]).to_vec();
     Ok(ReplayReport {
         model: model.to_owned(),
         samples: x.len(),
         dt_s: dt,
-        metrics: metrics(y, &model_output, Some((&dx, &ddx))),
+        metrics: metrics(&part(y), &part(&model_output), Some((&part(&dx), &part(&ddx)))),
         held: out.held,
         time: t.to_vec(),
         measured: y.to_vec(),

@@ -139,7 +139,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     let mut rows = Vec::new();
     let mut replays = Vec::new();
     for f in &fits {
-        let r = replay_recording(&f.rec, &dyke_channels(), &pf.model, &flat, RateChoice::Backward)?;
+        let r = replay_recording(&f.rec, &dyke_channels(), &pf.model, &flat, RateChoice::Backward, (0.0, 0.0))?;
         let m = r.metrics;
         rows.push(vec![
             f.file.to_owned(),

@@ -4,7 +4,7 @@ use std::time::Instant;
 use anyhow::{bail, Context};
 use clap::Args;
 use hil_sim::fit::spec::FITTABLE;
-use hil_sim::fit::{fit, Dataset, FitOptions, FitResult};
+use hil_sim::fit::{fit, Dataset, DelayChoice, FitOptions, FitResult};
 use hil_sim::params_file::ParamsFile;
 use hil_sim::quality;
 use hil_sim::recording::Recording;
@@ -25,6 +25,12 @@ pub struct FitArgs {
     pub train: f64,
     #[command(flatten)]
     pub ch: ChannelArgs,
+    /// Channel alignment (physics-catalog `transport_delay`): `auto` fits an input delay, and
+    /// a command delay when there is `--command`, with each model's parameters (±8 samples);
+    /// `off` takes the channels as recorded; `D` or `D,DU` are known delays in seconds (the
+    /// model is fed `x(t + D)` and `u(t + DU)`).
+    #[arg(long, default_value = "auto", value_parser = parse_delay)]
+    pub delay: DelayChoice,
     /// Seed of the global search (results are reproducible for a given seed).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -36,6 +42,24 @@ pub struct FitArgs {
     pub out: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
+}
+
+/// `auto`, `off` or seconds, the syntax of `--delay`.
+pub fn parse_delay(s: &str) -> Result<DelayChoice, String> {
+    match s {
+        "auto" => Ok(DelayChoice::Auto),
+        "off" | "0" => Ok(DelayChoice::Off),
+        _ => {
+            let bad = || format!("`{s}`: expected `auto`, `off`, or delays in seconds `D` or `D,DU`");
+            let mut it = s.split(',').map(|v| v.trim().parse::<f64>().ok().filter(|v| v.is_finite()));
+            let d = it.next().flatten().ok_or_else(bad)?;
+            let d_u = it.next().map_or(Some(0.0), |v| v).ok_or_else(bad)?;
+            if it.next().is_some() {
+                return Err(bad());
+            }
+            Ok(DelayChoice::Fixed(d, d_u))
+        }
+    }
 }
 
 /// The models `--model` names.
@@ -85,7 +109,7 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
     }
     let excluded = (!a.ch.keep_flagged).then(|| q.excluded());
     let data = Dataset::new(&rec, &ch, a.train, excluded).with_context(|| format!("{}", path.display()))?;
-    let mut opts = FitOptions { rate, ..Default::default() };
+    let mut opts = FitOptions { rate, delay: a.delay, ..Default::default() };
     opts.swarm.seed = a.seed;
     let t0 = Instant::now();
     let results = fit_all(&data, &ids, &opts)?;
@@ -97,6 +121,8 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
             let mut pf = ParamsFile::from_flat(&r.model, Some(format!("hil-sim fit {}", path.display())), &flat)
                 .context("building the parameter file")?;
             pf.rate = Some(r.rate.clone());
+            pf.delay_s = (r.delay_s != 0.0).then_some(r.delay_s);
+            pf.command_delay_s = (r.command_delay_s != 0.0).then_some(r.command_delay_s);
             let file = dir.join(format!("{}.json", r.model));
             std::fs::write(&file, serde_json::to_string_pretty(&pf)? + "\n")
                 .with_context(|| format!("writing {}", file.display()))?;
@@ -146,12 +172,22 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
 /// The comparison table, one row per model.
 pub fn table(results: &[FitResult]) -> String {
     let mut s = format!(
-        "{:<16} {:>6} {:>10} {:>9} {:>8} {:>10} {:>9} {:>8} {:>8} {:>9}\n",
-        "model", "params", "train RMSE", "train R²", "method", "held RMSE", "held R²", "R-RMSE", "fit s", "ns/step"
+        "{:<16} {:>6} {:>10} {:>9} {:>8} {:>10} {:>9} {:>8} {:>8} {:>9} {:>13}\n",
+        "model",
+        "params",
+        "train RMSE",
+        "train R²",
+        "method",
+        "held RMSE",
+        "held R²",
+        "R-RMSE",
+        "fit s",
+        "ns/step",
+        "delay x/u ms"
     );
     for r in results {
         s += &format!(
-            "{:<16} {:>6} {:>10.4} {:>9.4} {:>8} {:>10.4} {:>9.4} {:>7.2}% {:>8.3} {:>9.1}\n",
+            "{:<16} {:>6} {:>10.4} {:>9.4} {:>8} {:>10.4} {:>9.4} {:>7.2}% {:>8.3} {:>9.1} {:>6.3}/{:<6.3}\n",
             r.model,
             r.free_params,
             r.train.rmse,
@@ -161,7 +197,9 @@ pub fn table(results: &[FitResult]) -> String {
             r.heldout.r2,
             100.0 * r.heldout.r_rmse,
             r.fit_seconds,
-            r.replay_ns_per_sample
+            r.replay_ns_per_sample,
+            1e3 * r.delay_s,
+            1e3 * r.command_delay_s
         );
     }
     s

@@ -19,6 +19,9 @@ pub struct ReplayArgs {
     pub params: PathBuf,
     #[command(flatten)]
     pub ch: ChannelArgs,
+    /// Also write the trace as CSV: `t,measured,model,residual` (one row per sample).
+    #[arg(long, value_name = "FILE")]
+    pub trace: Option<PathBuf>,
     #[arg(long)]
     pub json: bool,
 }
@@ -36,8 +39,19 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
     }
-    let r = replay_recording(&rec, &a.ch.channels(), &pf.model, &flat, rate)
-        .with_context(|| format!("replaying {}", a.rec.display()))?;
+    let r = replay_recording(
+        &rec,
+        &a.ch.channels(),
+        &pf.model,
+        &flat,
+        rate,
+        (pf.delay_s.unwrap_or(0.0), pf.command_delay_s.unwrap_or(0.0)),
+    )
+    .with_context(|| format!("replaying {}", a.rec.display()))?;
+    if let Some(path) = &a.trace {
+        write_trace(path, &r).with_context(|| format!("writing trace {}", path.display()))?;
+        eprintln!("wrote {}", path.display());
+    }
     if a.json {
         return super::print_json(&json!({
             "model": r.model, "samples": r.samples, "dt_s": r.dt_s,
@@ -61,5 +75,16 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
         m.gof,
         r.held
     ));
+    Ok(())
+}
+
+/// `t,measured,model,residual` with a header row.
+fn write_trace(path: &std::path::Path, r: &hil_sim::replay::ReplayReport) -> anyhow::Result<()> {
+    let mut w = csv::Writer::from_path(path)?;
+    w.write_record(["t", "measured", "model", "residual"])?;
+    for ((t, y), m) in r.time.iter().zip(&r.measured).zip(&r.model_output) {
+        w.write_record([t.to_string(), y.to_string(), m.to_string(), (y - m).to_string()])?;
+    }
+    w.flush()?;
     Ok(())
 }

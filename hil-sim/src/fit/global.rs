@@ -25,7 +25,7 @@ pub struct SwarmOptions {
 
 impl Default for SwarmOptions {
     fn default() -> Self {
-        Self { particles: 24, iterations: 20, seed: 1, keep: 2 }
+        Self { particles: 48, iterations: 20, seed: 1, keep: 3 }
     }
 }
 

@@ -8,8 +8,18 @@
 use model_core::Kin;
 use nalgebra::{DMatrix, DVector};
 
+/// Most regressors any linear model has.
+const MAX_REGRESSORS: usize = 10;
+
 /// Regressor row of model `id` at one sample (`None` for a model that is not linear).
 pub fn regressors(id: &str, k: &Kin) -> Option<Vec<f64>> {
+    let mut row = [0.0; MAX_REGRESSORS];
+    let n = regressors_into(id, k, &mut row)?;
+    Some(row.get(..n)?.to_vec())
+}
+
+/// Write the regressor row of `id` at `k` into `row`; returns how many there are.
+fn regressors_into(id: &str, k: &Kin, row: &mut [f64; MAX_REGRESSORS]) -> Option<usize> {
     let (x, dx, u) = (f64::from(k.x), f64::from(k.dx), f64::from(k.u));
     let sgn = |v: f64| {
         if v > 0.0 {
@@ -20,48 +30,72 @@ pub fn regressors(id: &str, k: &Kin) -> Option<Vec<f64>> {
             0.0
         }
     };
-    Some(match id {
+    match id {
         // T = k·B + c·Ḃ + α·|B|·B³ + T₀
-        "algebraic" => vec![x, dx, x.abs() * x.powi(3), 1.0],
+        "algebraic" => {
+            row[..4].copy_from_slice(&[x, dx, x.abs() * x.powi(3), 1.0]);
+            Some(4)
+        }
         // F = (fc0 + fc1·u + fc2·u² + fc3·u³)·sgn(ẋ) + (c0_0 + … + c0_4·u⁴)·ẋ + f0
         "bingham" => {
             let s = sgn(dx);
-            vec![s, s * u, s * u * u, s * u.powi(3), dx, dx * u, dx * u * u, dx * u.powi(3), dx * u.powi(4), 1.0]
+            *row = [s, s * u, s * u * u, s * u.powi(3), dx, dx * u, dx * u * u, dx * u.powi(3), dx * u.powi(4), 1.0];
+            Some(10)
         }
-        _ => return None,
-    })
+        _ => None,
+    }
 }
 
 /// Least-squares solution over the rows `rows` of the free columns `free`; fixed
 /// parameters keep their value in `p` (their contribution is subtracted first).
-/// Columns are scaled to unit norm and solved by SVD, so a column the data does not excite
-/// gets a zero coefficient instead of a blow-up. `None` for a model that is not linear.
+///
+/// One pass accumulates the normal equations `AᵀA·θ = Aᵀb` (at most 10 columns, so this
+/// costs a few multiply-adds per sample and no m×n matrix). The columns are scaled to unit
+/// norm and the small system is solved by SVD with a relative cut-off, so a column the data
+/// does not excite gets a zero coefficient instead of a blow-up. `None` for a model that is
+/// not linear.
 pub fn solve(id: &str, kin: &[Kin], y: &[f64], rows: &[usize], free: &[usize], p: &[f64]) -> Option<Vec<f64>> {
-    let m = rows.len();
     let n = free.len();
-    let mut a = DMatrix::<f64>::zeros(m, n);
-    let mut b = DVector::<f64>::zeros(m);
-    for (r, &i) in rows.iter().enumerate() {
-        let phi = regressors(id, kin.get(i)?)?;
-        let fixed: f64 =
-            phi.iter().zip(p).enumerate().filter(|(j, _)| !free.contains(j)).map(|(_, (f, v))| f * v).sum();
-        b[r] = y.get(i)? - fixed;
+    let mut gram = DMatrix::<f64>::zeros(n, n);
+    let mut atb = DVector::<f64>::zeros(n);
+    let mut phi = [0.0; MAX_REGRESSORS];
+    let mut is_free = [false; MAX_REGRESSORS];
+    for &j in free {
+        *is_free.get_mut(j)? = true;
+    }
+    let mut a = [0.0; MAX_REGRESSORS];
+    for &i in rows {
+        let len = regressors_into(id, kin.get(i)?, &mut phi)?;
+        let fixed: f64 = (0..len).filter(|&j| !is_free[j]).map(|j| phi[j] * p.get(j).copied().unwrap_or(0.0)).sum();
+        let b = y.get(i)? - fixed;
         for (c, &j) in free.iter().enumerate() {
-            a[(r, c)] = *phi.get(j)?;
+            a[c] = *phi.get(j)?;
+        }
+        for r in 0..n {
+            atb[r] += a[r] * b;
+            for c in 0..=r {
+                gram[(r, c)] += a[r] * a[c];
+            }
         }
     }
-    let norms: Vec<f64> = (0..n).map(|c| a.column(c).norm()).collect();
-    for (c, nrm) in norms.iter().enumerate() {
-        if *nrm > 0.0 {
-            a.column_mut(c).scale_mut(1.0 / nrm);
+    for r in 0..n {
+        for c in 0..r {
+            gram[(c, r)] = gram[(r, c)];
         }
     }
-    let svd = a.svd(true, true);
-    let sol = svd.solve(&b, 1e-12).ok()?;
+    let scale: Vec<f64> = (0..n).map(|c| gram[(c, c)].sqrt()).map(|v| if v > 0.0 { 1.0 / v } else { 0.0 }).collect();
+    for r in 0..n {
+        atb[r] *= scale[r];
+        for c in 0..n {
+            gram[(r, c)] *= scale[r] * scale[c];
+        }
+    }
+    let svd = gram.svd(true, true);
+    let cut = 1e-13 * svd.singular_values.max();
+    let sol = svd.solve(&atb, cut).ok()?;
     let mut out = p.to_vec();
     for (c, &j) in free.iter().enumerate() {
-        let nrm = norms.get(c).copied().unwrap_or(0.0);
-        *out.get_mut(j)? = if nrm > 0.0 { sol[c] / nrm } else { 0.0 };
+        *out.get_mut(j)? = sol[c] * scale.get(c).copied().unwrap_or(0.0);
     }
     Some(out)
 }

@@ -150,11 +150,25 @@ impl Dataset {
     }
 }
 
+/// Whether the fit aligns the input channel with the output ([`crate::alignment`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DelayChoice {
+    /// No shift: the channels are taken as recorded.
+    Off,
+    /// Fit the delays with the model's parameters (within ±8 samples): the input's, and the
+    /// command's when there is a command channel (the closed-form models fit the input's only).
+    Auto,
+    /// Known delays, seconds: input, command.
+    Fixed(f64, f64),
+}
+
 /// How hard to search.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FitOptions {
     /// Rate estimator for every model (`None`: each model's preferred one).
     pub rate: Option<RateChoice>,
+    /// Input delay: fitted (default), off, or given.
+    pub delay: DelayChoice,
     pub swarm: SwarmOptions,
     /// Samples of the training part the swarm scores (the start of it), to keep the global
     /// phase cheap; Levenberg–Marquardt then uses the whole training part.
@@ -166,7 +180,13 @@ pub struct FitOptions {
 
 impl Default for FitOptions {
     fn default() -> Self {
-        Self { rate: None, swarm: SwarmOptions::default(), swarm_window: 9_000, lm_iterations: 15 }
+        Self {
+            rate: None,
+            delay: DelayChoice::Auto,
+            swarm: SwarmOptions::default(),
+            swarm_window: 9_000,
+            lm_iterations: 15,
+        }
     }
 }
 
@@ -176,6 +196,10 @@ pub struct FitResult {
     pub model: String,
     /// Fitted parameters by name (blocks as arrays).
     pub params: Values,
+    /// Input delay the model is fed with, seconds (`x(t + delay_s)`; 0 when not fitted).
+    pub delay_s: f64,
+    /// Command delay, seconds (`u(t + command_delay_s)`; 0 without a command or a fit).
+    pub command_delay_s: f64,
     /// On the training samples the fit used (flagged ones left out).
     pub train: Metrics,
     /// On every held-out sample.
@@ -226,11 +250,45 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     let kin = simulate::kinematics(&samples, dt, sp.rate).ok_or(FitError::RateOverflow { model: id.to_owned() })?;
     let sim = simulate::simulator(id, dt).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
     let rows = data.train_rows();
-    let (params, evaluations) = identify(id, &sp, sim.as_ref(), &kin, &data.output, &rows, scales.y, opts)?;
+    let fit_at = |kin: &[model_core::Kin], sp: &ModelSpec| {
+        identify(id, sp, sim.as_ref(), kin, &data.output, &rows, scales.y, opts)
+    };
+    let n_model = sim.n_params();
+    let ((mut params, evaluations), (delay, delay_u)) = match (opts.delay, sp.strategy) {
+        (DelayChoice::Off, _) => (fit_at(&kin, &sp)?, (0.0, 0.0)),
+        (DelayChoice::Fixed(s, s_u), _) => {
+            let d = (s / data.dt, if data.command.is_some() { s_u / data.dt } else { 0.0 });
+            let mut shifted = Vec::new();
+            crate::alignment::shift_kin(&kin, d.0, d.1, &mut shifted);
+            (fit_at(&shifted, &sp)?, d)
+        }
+        (DelayChoice::Auto, Strategy::Linear) => {
+            let found = scan_delay(&kin, |k| {
+                let r = fit_at(k, &sp).ok()?;
+                let cost = Objective::new(sim.as_ref(), &sp, k, &data.output, &rows, scales.y).cost(&r.0);
+                Some((r, cost))
+            })
+            .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
+            (found.0, (found.1, 0.0))
+        }
+        (DelayChoice::Auto, _) => {
+            let spd = sp.clone().with_delays(data.command.is_some() && uses_command(id, &scales));
+            let (p, e) = fit_at(&kin, &spd)?;
+            let d = (p.get(n_model).copied().unwrap_or(0.0), p.get(n_model + 1).copied().unwrap_or(0.0));
+            ((p, e), d)
+        }
+    };
+    params.truncate(n_model);
     let fit_seconds = started.elapsed().as_secs_f64();
 
     // Score with the Estimator path, the firmware's code, over the whole recording.
     let p32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
+    let samples = if delay == 0.0 && delay_u == 0.0 {
+        samples
+    } else {
+        let u = data.command.as_deref().map(|u| crate::alignment::shift(u, delay_u));
+        crate::replay::samples(&crate::alignment::shift(&data.input, delay), u.as_deref())
+    };
     let t0 = Instant::now();
     let rep = replay(id, &p32, dt, sp.rate, &samples)
         .map_err(|e| FitError::Replay { model: id.to_owned(), reason: e.to_string() })?;
@@ -242,13 +300,19 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         let pick = |v: &[f64]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
         metrics(&pick(&data.output), &pick(&output), Some((&pick(&dx), &pick(&ddx))))
     };
-    let unflagged = data.heldout_unflagged();
-    let all_heldout: Vec<usize> = (data.train_end..data.len()).collect();
+    // A delayed channel has no data for the first or last few samples: those are not scored.
+    let n = data.len();
+    let (lo, hi) = crate::alignment::covered(n, &[delay, delay_u]);
+    let unflagged: Vec<usize> = data.heldout_unflagged().into_iter().filter(|i| (lo..hi).contains(i)).collect();
+    let all_heldout: Vec<usize> = (data.train_end..n).filter(|i| (lo..hi).contains(i)).collect();
+    let rows: Vec<usize> = rows.into_iter().filter(|i| (lo..hi).contains(i)).collect();
     let flat32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
     let named = ParamsFile::from_flat(id, None, &flat32).map(|f| f.params).unwrap_or(Values::Flat(params.clone()));
     Ok(FitResult {
         model: id.to_owned(),
         params: named,
+        delay_s: delay * data.dt,
+        command_delay_s: delay_u * data.dt,
         train: score(&rows),
         heldout: score(&all_heldout),
         heldout_unflagged: (unflagged.len() != all_heldout.len()).then(|| score(&unflagged)),
@@ -265,6 +329,13 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         rate_choice: sp.rate,
         output,
     })
+}
+
+/// Whether model `id` has a command-dependent parameter the fit frees (its spec fixes more
+/// parameters when the recording has no command channel).
+fn uses_command(id: &str, scales: &Scales) -> bool {
+    let free = |s: &Scales| spec::spec(id, s, None).map_or(0, |sp| sp.free().len());
+    free(&Scales { u: None, ..*scales }) < free(scales)
 }
 
 /// The search itself: returns the parameters and the number of model evaluations.
@@ -284,7 +355,7 @@ fn identify(
         Strategy::Linear => {
             let p = linear::solve(id, kin, y, rows, &sp.free(), &sp.start())
                 .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
-            if sim.valid(&p) {
+            if sim.valid(p.get(..sim.n_params()).unwrap_or(&p)) {
                 return Ok((p, 1));
             }
             // A sign bound is active: continue from the box-clamped solution under LM.
@@ -320,15 +391,118 @@ fn identify(
     }
 }
 
+/// Fit at every whole-sample delay in ±[`MAX_DELAY_SAMPLES`](crate::alignment::MAX_DELAY_SAMPLES)
+/// (`at` fits on the shifted kinematics and returns the fit and its training cost), then
+/// refine the best by a parabola through it and its neighbours. Returns the best fit and
+/// its delay in samples. For the closed-form models, where a fit costs one pass.
+fn scan_delay<T>(
+    kin: &[model_core::Kin],
+    at: impl Fn(&[model_core::Kin]) -> Option<(T, f64)> + Sync,
+) -> Option<(T, f64)>
+where
+    T: Send,
+{
+    use rayon::prelude::*;
+    let m = crate::alignment::MAX_DELAY_SAMPLES as i32;
+    let fit_shifted = |d: f64| {
+        let mut shifted = Vec::new();
+        crate::alignment::shift_kin(kin, d, 0.0, &mut shifted);
+        at(&shifted).map(|(r, c)| (r, c, d))
+    };
+    let grid: Vec<Option<(T, f64, f64)>> = (-m..=m).into_par_iter().map(|d| fit_shifted(f64::from(d))).collect();
+    let cost_at = |i: usize| grid.get(i).and_then(|g| g.as_ref()).map_or(f64::INFINITY, |g| g.1);
+    let best =
+        (0..grid.len()).filter(|&i| cost_at(i).is_finite()).min_by(|&a, &b| cost_at(a).total_cmp(&cost_at(b)))?;
+    let (c_l, c_0, c_r) = (cost_at(best.wrapping_sub(1)), cost_at(best), cost_at(best + 1));
+    let curv = c_l - 2.0 * c_0 + c_r;
+    let refined = (curv.is_finite() && curv > 0.0).then(|| 0.5 * (c_l - c_r) / curv).and_then(|off| {
+        let d = (best as f64 - f64::from(m)) + off.clamp(-0.5, 0.5);
+        fit_shifted(d)
+    });
+    let mut grid = grid;
+    let coarse = grid.get_mut(best)?.take()?;
+    let winner = match refined {
+        Some(r) if r.1 < coarse.1 => r,
+        _ => coarse,
+    };
+    Some((winner.0, winner.2))
+}
+
 fn valid_or_err(
     id: &str,
     sim: &dyn simulate::Simulator,
     p: Vec<f64>,
     evals: usize,
 ) -> Result<(Vec<f64>, usize), FitError> {
-    if sim.valid(&p) {
+    if sim.valid(p.get(..sim.n_params()).unwrap_or(&p)) {
         Ok((p, evals))
     } else {
         Err(FitError::NoValidSet { model: id.to_owned() })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dispatch::replay;
+
+    /// A recording of `id` with `truth`, whose input channel was logged `lag` samples late.
+    fn lagged(id: &str, truth: &[f32], lag: f64, command: bool) -> Dataset {
+        let dt = 1e-3;
+        let n = 6000;
+        let time: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
+        let x_true: Vec<f64> = time
+            .iter()
+            .map(|t| (2.0 * std::f64::consts::PI * 3.0 * t).sin() + 0.4 * (2.0 * std::f64::consts::PI * 11.0 * t).sin())
+            .collect();
+        let u = command.then(|| time.iter().map(|t| 1.0 + 0.8 * (3.1 * t).sin()).collect::<Vec<f64>>());
+        let samples = crate::replay::samples(&x_true, u.as_deref());
+        let out = replay(id, truth, dt as f32, RateChoice::Backward, &samples).unwrap();
+        // The logged input is the true one `lag` samples late: x_log(t) = x_true(t − lag).
+        let input = crate::alignment::shift(&x_true, -lag);
+        Dataset {
+            dt,
+            time,
+            input,
+            output: out.y.iter().map(|v| f64::from(*v)).collect(),
+            command: u,
+            train_end: 4200,
+            excluded: vec![false; n],
+        }
+    }
+
+    fn opts(delay: DelayChoice) -> FitOptions {
+        // Noiseless data: let Levenberg–Marquardt run to convergence.
+        FitOptions { rate: Some(RateChoice::Backward), delay, lm_iterations: 80, ..FitOptions::default() }
+    }
+
+    #[test]
+    fn closed_form_fit_finds_a_known_input_delay() {
+        let data = lagged("algebraic", &[2.0, 0.05, -0.3, 0.1], 3.0, false);
+        let auto = fit("algebraic", &data, &opts(DelayChoice::Auto)).unwrap();
+        let off = fit("algebraic", &data, &opts(DelayChoice::Off)).unwrap();
+        assert!((auto.delay_s - 3e-3).abs() < 0.3e-3, "delay {} s", auto.delay_s);
+        assert_eq!(off.delay_s, 0.0);
+        assert!(auto.heldout.rmse < 1e-3 * off.heldout.rmse, "{} vs {}", auto.heldout.rmse, off.heldout.rmse);
+    }
+
+    #[test]
+    fn iterative_fit_finds_a_known_input_delay() {
+        let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
+        let data = lagged("bouc_wen", &truth, -2.5, false);
+        let auto = fit("bouc_wen", &data, &opts(DelayChoice::Auto)).unwrap();
+        let off = fit("bouc_wen", &data, &opts(DelayChoice::Off)).unwrap();
+        assert!(
+            (auto.delay_s + 2.5e-3).abs() < 0.5e-3,
+            "delay {} s, rmse {} vs {}",
+            auto.delay_s,
+            auto.train.rmse,
+            off.train.rmse
+        );
+        assert_eq!(auto.command_delay_s, 0.0, "no command channel, no command delay");
+        assert!(auto.train.rmse < off.train.rmse, "{} vs {}", auto.train.rmse, off.train.rmse);
+        // A given delay is used as given.
+        let fixed = fit("bouc_wen", &data, &opts(DelayChoice::Fixed(-2.5e-3, 0.0))).unwrap();
+        assert!((fixed.delay_s + 2.5e-3).abs() < 1e-12);
     }
 }

@@ -5,17 +5,23 @@ use model_core::Kin;
 
 use super::simulate::Simulator;
 use super::spec::ModelSpec;
+use crate::alignment::{shift_kin, MAX_DELAY_SAMPLES};
 
 /// Residuals of one model on one stretch of data.
 ///
 /// The model runs over every sample from the start of `kin` (its state must see the
 /// whole history) but only `rows` (training samples not flagged by the quality checks)
-/// enter the sum. Residuals are divided by `scale` (the output's spread) so that the
+/// enter the sum. When the spec carries more entries than the model has parameters, the
+/// first is an input delay and the second a command delay, in samples
+/// ([`crate::alignment`]), fitted with the rest. Residuals are divided by `scale` (the output's spread) so that the
 /// tolerances of the optimisers mean the same thing in every unit.
 pub struct Objective<'a> {
     pub sim: &'a dyn Simulator,
     pub spec: &'a ModelSpec,
+    /// The kinematics up to the last row, plus a margin for the delay to read ahead.
     pub kin: &'a [Kin],
+    /// Samples the model runs over (one past the last row).
+    pub end: usize,
     pub y: &'a [f64],
     pub rows: &'a [usize],
     pub scale: f64,
@@ -33,7 +39,19 @@ impl<'a> Objective<'a> {
         scale: f64,
     ) -> Self {
         let end = rows.last().map_or(0, |r| r + 1).min(kin.len());
-        Self { sim, spec, kin: &kin[..end], y, rows, scale: scale.max(1e-300), free: spec.free() }
+        let ext = (end + MAX_DELAY_SAMPLES.ceil() as usize + 1).min(kin.len());
+        Self { sim, spec, kin: &kin[..ext], end, y, rows, scale: scale.max(1e-300), free: spec.free() }
+    }
+
+    /// The model's own parameters of a full vector `p` (without the delay entry).
+    pub fn model_params<'p>(&self, p: &'p [f64]) -> &'p [f64] {
+        p.get(..self.sim.n_params()).unwrap_or(p)
+    }
+
+    /// The input and command delays in samples that `p` carries (0 when the spec has none).
+    pub fn delays(&self, p: &[f64]) -> (f64, f64) {
+        let n = self.sim.n_params();
+        (p.get(n).copied().unwrap_or(0.0), p.get(n + 1).copied().unwrap_or(0.0))
     }
 
     /// The full parameter vector for free-parameter positions `unit` (each in [0, 1] of its box).
@@ -54,8 +72,16 @@ impl<'a> Objective<'a> {
 
     /// Scaled residuals at `p`, `None` when the model rejects `p` or diverges.
     pub fn residuals(&self, p: &[f64]) -> Option<Vec<f64>> {
-        let mut out = vec![0.0; self.kin.len()];
-        if !self.sim.run(p, self.kin, &mut out) {
+        let mut out = vec![0.0; self.end];
+        let (d, d_u) = self.delays(p);
+        let ok = if d == 0.0 && d_u == 0.0 {
+            self.sim.run(self.model_params(p), self.kin.get(..self.end)?, &mut out)
+        } else {
+            let mut shifted = Vec::with_capacity(self.kin.len());
+            shift_kin(self.kin, d, d_u, &mut shifted);
+            self.sim.run(self.model_params(p), shifted.get(..self.end)?, &mut out)
+        };
+        if !ok {
             return None;
         }
         let inv = 1.0 / self.scale;

@@ -144,6 +144,18 @@ impl ModelSpec {
     pub fn start(&self) -> Vec<f64> {
         self.params.iter().map(|p| p.start).collect()
     }
+    /// The same search with free entries after the model's parameters: an input delay and,
+    /// with `command`, a command delay, in samples within
+    /// ±[`MAX_DELAY_SAMPLES`](crate::alignment::MAX_DELAY_SAMPLES), starting at 0
+    /// ([`crate::alignment`]).
+    pub fn with_delays(mut self, command: bool) -> Self {
+        let m = crate::alignment::MAX_DELAY_SAMPLES;
+        self.params.push(ParamSpec::new("delay", -m, m, 0.0));
+        if command {
+            self.params.push(ParamSpec::new("command_delay", -m, m, 0.0));
+        }
+        self
+    }
     /// Indices of the free parameters.
     pub fn free(&self) -> Vec<usize> {
         self.params.iter().enumerate().filter(|(_, p)| !p.fixed).map(|(i, _)| i).collect()
