@@ -2,6 +2,7 @@
 //! accuracy checks of the fixed-step core.
 
 pub mod accuracy;
+pub mod budget;
 pub mod closed_loop;
 pub mod compare;
 pub mod data;

@@ -2,6 +2,7 @@
 //! then stdout carries exactly one JSON object; progress and logs go to stderr.
 
 mod accuracy;
+mod budget;
 mod compare;
 mod demo;
 mod fit;
@@ -42,6 +43,8 @@ pub enum Cmd {
     Simulate(simulate::SimulateArgs),
     /// Closed loop: the firmware's control step against the simulated clutch.
     Loop(loop_cmd::LoopArgs),
+    /// Instructions, cycles and stack per step on the Cortex-M4F (QEMU mps2-an386).
+    Budget(budget::BudgetArgs),
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
@@ -54,6 +57,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Cmd::Demo(a) => demo::run(a),
         Cmd::Simulate(a) => simulate::run_cmd(a),
         Cmd::Loop(a) => loop_cmd::run_cmd(a),
+        Cmd::Budget(a) => budget::run(a),
     }
 }
 
