@@ -57,10 +57,12 @@ pub const BUDGETS: [Budget; 5] = [
 pub const CONTROL_HZ: f64 = 20_000.0;
 pub const CORE_HZ: f64 = 170.0e6;
 
-/// One `step <name> <address> <calls>` line of the bench.
+/// One `step|outside <name> <address> <calls>` line of the bench.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Marker {
     pub name: String,
+    /// A sweep beyond the 20 kHz operating envelope (reported apart, no budget).
+    pub outside: bool,
     /// Entry address (Thumb bit cleared).
     pub address: u32,
     /// Calls the bench makes.
@@ -74,14 +76,14 @@ pub fn parse_markers(stdout: &str) -> anyhow::Result<Vec<Marker>> {
     for line in stdout.lines().map(str::trim) {
         let mut it = line.split_whitespace();
         match it.next() {
-            Some("step") => {
+            Some(kind @ ("step" | "outside")) => {
                 let (Some(name), Some(addr), Some(calls)) = (it.next(), it.next(), it.next()) else {
                     bail!("bench output: malformed line `{line}`");
                 };
                 let address = u32::from_str_radix(addr.trim_start_matches("0x"), 16)
                     .with_context(|| format!("bench output: bad address in `{line}`"))?;
                 let calls = calls.parse().with_context(|| format!("bench output: bad call count in `{line}`"))?;
-                out.push(Marker { name: name.to_owned(), address: address & !1, calls });
+                out.push(Marker { name: name.to_owned(), outside: kind == "outside", address: address & !1, calls });
             }
             Some("error") => bail!("the bench failed: {line}"),
             Some("done") => done = true,
@@ -245,6 +247,8 @@ pub struct StepFigures {
     /// Deepest stack below the entry SP, bytes.
     pub stack_bytes: u32,
     pub calls: u64,
+    /// Measured beyond the operating envelope (no budget applies).
+    pub outside: bool,
     /// The target, if [`BUDGETS`] has one.
     pub budget: Option<Budget>,
 }
@@ -288,7 +292,9 @@ struct Acc {
 /// Streaming parser of QEMU's `-d exec,cpu,nochain` log.
 pub struct Tracer<'a> {
     markers: &'a [Marker],
-    entries: HashMap<u32, usize>,
+    /// Entry address → the markers measuring it, in the bench's order (a function swept
+    /// twice is attributed to its first marker until that one has all its calls).
+    entries: HashMap<u32, Vec<usize>>,
     cycles: &'a HashMap<u32, Cycles>,
     open: Option<Open>,
     acc: Vec<Acc>,
@@ -307,7 +313,10 @@ fn hex_after(line: &[u8], key: &[u8]) -> Option<u32> {
 
 impl<'a> Tracer<'a> {
     pub fn new(markers: &'a [Marker], cycles: &'a HashMap<u32, Cycles>) -> Self {
-        let entries = markers.iter().enumerate().map(|(i, m)| (m.address, i)).collect();
+        let mut entries: HashMap<u32, Vec<usize>> = HashMap::new();
+        for (i, m) in markers.iter().enumerate() {
+            entries.entry(m.address).or_default().push(i);
+        }
         Self {
             markers,
             entries,
@@ -369,7 +378,10 @@ impl<'a> Tracer<'a> {
                 o.min_sp = o.min_sp.min(sp);
             }
             None => {
-                if let Some(&marker) = self.entries.get(&pc) {
+                let marker = self.entries.get(&pc).and_then(|list| {
+                    list.iter().copied().find(|&i| self.acc[i].calls < self.markers[i].calls).or(list.last().copied())
+                });
+                if let Some(marker) = marker {
                     self.open = Some(Open { marker, ret: lr & !1, sp0: sp, min_sp: sp, instructions: 1, cyc });
                 }
             }
@@ -395,7 +407,8 @@ impl<'a> Tracer<'a> {
                 cycles_max: a.cyc_max,
                 stack_bytes: a.stack,
                 calls: a.calls,
-                budget: BUDGETS.iter().find(|b| b.name == m.name).copied(),
+                outside: m.outside,
+                budget: if m.outside { None } else { BUDGETS.iter().find(|b| b.name == m.name).copied() },
             });
         }
         Ok(out)
@@ -569,18 +582,20 @@ fn parse_qemu_version(text: &str) -> Option<(u32, u32)> {
 
 /// Plain-text table of a report.
 pub fn table(r: &Report) -> String {
-    let mut s = format!(
-        "{:<20} {:>6} {:>8} {:>13} {:>6}  {:<14} {}\n",
-        "step", "instr", "mean", "cycles", "stack", "budget", "status"
-    );
-    for st in &r.steps {
+    let head = |title: &str| {
+        format!(
+            "{:<20} {:>6} {:>8} {:>13} {:>6}  {:<14} {}\n",
+            title, "instr", "mean", "cycles", "stack", "budget", "status"
+        )
+    };
+    let row = |st: &StepFigures| {
         let budget = st.budget.map_or_else(|| "-".to_owned(), |b| format!("{} / {} B", b.instructions, b.stack_bytes));
         let status = match (st.budget, st.excess().is_empty()) {
             (None, _) => "",
             (Some(_), true) => "ok",
             (Some(_), false) => "OVER",
         };
-        s += &format!(
+        format!(
             "{:<20} {:>6} {:>8.1} {:>13} {:>5}B  {:<14} {}\n",
             st.name,
             st.instructions,
@@ -589,9 +604,13 @@ pub fn table(r: &Report) -> String {
             st.stack_bytes,
             budget,
             status
-        );
+        )
+    };
+    let mut s = head("step (20 kHz sweep)");
+    for st in r.steps.iter().filter(|s| !s.outside) {
+        s += &row(st);
     }
-    if let Some(cs) = r.steps.iter().find(|s| s.name == "control_step") {
+    if let Some(cs) = r.steps.iter().find(|s| s.name == "control_step" && !s.outside) {
         s += &format!(
             "control_step at {:.0} kHz on {:.0} MHz: {:.1}-{:.1} % of the CPU (worst call)\n",
             CONTROL_HZ / 1e3,
@@ -599,6 +618,13 @@ pub fn table(r: &Report) -> String {
             100.0 * cs.cycles_min as f64 * CONTROL_HZ / CORE_HZ,
             100.0 * cs.cycles_max as f64 * CONTROL_HZ / CORE_HZ
         );
+    }
+    if r.steps.iter().any(|s| s.outside) {
+        s += "\n";
+        s += &head("outside the envelope");
+        for st in r.steps.iter().filter(|s| s.outside) {
+            s += &row(st);
+        }
     }
     s
 }
@@ -641,7 +667,7 @@ mod tests {
     #[test]
     fn markers_and_errors() {
         let m = parse_markers("step algebraic 0xdf0d 212\nstep control_step 0x14a4 400\ndone\n").unwrap();
-        assert_eq!(m[0], Marker { name: "algebraic".into(), address: 0xdf0c, calls: 212 });
+        assert_eq!(m[0], Marker { name: "algebraic".into(), outside: false, address: 0xdf0c, calls: 212 });
         assert_eq!(m[1].address, 0x14a4);
         assert!(parse_markers("step a 0x10 1\n").unwrap_err().to_string().contains("did not finish"));
         assert!(parse_markers("error lugre: bad\n").unwrap_err().to_string().contains("lugre: bad"));
@@ -651,7 +677,10 @@ mod tests {
     /// calls a helper at 0x200 that pushes 8 more, and returns.
     #[test]
     fn tracer_counts_calls_instructions_and_stack() {
-        let markers = vec![Marker { name: "algebraic".into(), address: 0x100, calls: 2 }];
+        let markers = vec![
+            Marker { name: "algebraic".into(), outside: false, address: 0x100, calls: 1 },
+            Marker { name: "algebraic".into(), outside: true, address: 0x100, calls: 1 },
+        ];
         let cycles: HashMap<u32, Cycles> =
             [(0x100, c(3, 3)), (0x102, c(1, 1)), (0x200, c(3, 3)), (0x202, c(3, 5)), (0x104, c(3, 5))]
                 .into_iter()
@@ -672,7 +701,8 @@ mod tests {
             feed(0x20, 0x2000_1000, 0x107); // back in the bench
         }
         let f = t.finish().unwrap();
-        assert_eq!(f[0].calls, 2);
+        assert_eq!((f[0].calls, f[1].calls), (1, 1));
+        assert!(f[1].outside && f[1].budget.is_none());
         assert_eq!(f[0].instructions, 5);
         assert_eq!(f[0].stack_bytes, 16);
         assert_eq!((f[0].cycles_min, f[0].cycles_max), (13, 17));

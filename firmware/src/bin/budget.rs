@@ -9,11 +9,14 @@
 //!    function that is measured and how many times it is called;
 //! 2. calls that function through a function pointer laundered by
 //!    [`core::hint::black_box`], so LTO can neither inline it into the loop nor specialise
-//!    it for the inputs, once per sample of an input sweep that visits every branch that
-//!    matters (rest, slow and fast travel, reversals, zero crossings of the hysteretic
-//!    state, sign changes of the input, large jumps; for the control step: calibration,
-//!    running with a multi-sine reference, reference limiting, the demagnetising pulse,
-//!    disable/enable).
+//!    it for the inputs, once per sample of an input sweep of the 20 kHz operating envelope
+//!    that visits every branch that matters there (rest, travel, reversals, zero crossings
+//!    of the hysteretic state, sign changes of the input; for the control step:
+//!    calibration, running with a multi-sine reference, reference limiting, the
+//!    demagnetising pulse, disable/enable);
+//! 3. prints `outside <name> <address> <calls>` and runs a second sweep beyond the
+//!    envelope (500 Hz full-span sine, jumps of the whole span in one sample), which
+//!    `hil-sim budget` reports apart, without a budget.
 //!
 //! `hil-sim budget` traces the run (`-singlestep -d exec,cpu,nochain`) and counts, per
 //! call, the instructions from the function's entry to its return and the lowest stack
@@ -53,51 +56,71 @@ mod bench {
         u_amp: f32,
     }
 
-    /// Rest, a slow sine (small steps, as at 20 kHz), a fast one (about 40 samples a
-    /// period: large steps, a reversal inside most steps), a sine around zero with twice
-    /// the amplitude, then jumps of the full span.
-    const SEGMENTS: [(u32, f32, f32); 4] = [
-        // (samples, samples per period, amplitude factor)
-        (6, 0.0, 0.0),
-        (30, 400.0, 1.0),
-        (45, 40.0, 1.0),
-        (30, 25.0, 2.0),
+    /// The operating envelope at 20 kHz: rest, 200 samples of a full-span 25 Hz sine (the
+    /// papers' excitations reach 10 Hz) through its peak (the reversal, then the zero
+    /// crossing of the hysteretic state that follows), then a 2 % dither at 200 Hz
+    /// (reversals every 50 samples). Segments continue from where the previous one ended.
+    const ENVELOPE: [Segment; 3] = [
+        Segment { n: 6, per: 0.0, gain: 0.0, phase: 0.0 },
+        Segment { n: 200, per: 800.0, gain: 1.0, phase: 1.45 },
+        Segment { n: 40, per: 100.0, gain: 0.02, phase: 0.0 },
     ];
+    /// Outside it (reported apart, without a budget): a 500 Hz full-span sine (large
+    /// steps, a reversal inside most of them) and jumps of the whole span in one sample.
+    const OUTSIDE: [Segment; 1] = [Segment { n: 45, per: 40.0, gain: 1.0, phase: 0.0 }];
     const JUMPS: [f32; 6] = [1.0, -1.0, 1.0, 0.5, -2.0, 2.0];
-    const CALLS: u32 = 6 + 30 + 45 + 30 + JUMPS.len() as u32;
 
-    /// Visit every sample of the sweep with exact kinematics (x, ẋ, ẍ of a sine; the jumps
-    /// with the rate a backward difference gives).
-    fn for_each_sample(sw: Sweep, mut f: impl FnMut(Kin)) {
-        let mut k = 0u32;
-        let mut prev = sw.off;
-        for (n, per, gain) in SEGMENTS {
-            let (c, s) = if per > 0.0 {
-                let w = 2.0 * core::f32::consts::PI / per;
-                (micromath::F32Ext::cos(w), micromath::F32Ext::sin(w))
-            } else {
-                (1.0, 0.0)
-            };
-            let omega = if per > 0.0 { 2.0 * core::f32::consts::PI / (per * DT) } else { 0.0 };
-            // Start a quarter period in, so the first sample already moves.
-            let (mut sn, mut cs) = (0.3f32, 0.954);
-            let amp = sw.amp * gain;
-            for _ in 0..n {
-                let (s1, c1) = (sn * c + cs * s, cs * c - sn * s);
-                (sn, cs) = (s1, c1);
-                let x = sw.off + amp * sn;
+    #[derive(Clone, Copy)]
+    struct Segment {
+        n: u32,
+        /// Samples per period (0: rest).
+        per: f32,
+        /// Amplitude as a fraction of the sweep's.
+        gain: f32,
+        /// Start phase, rad.
+        phase: f32,
+    }
+
+    const fn calls(segs: &[Segment], jumps: usize) -> u32 {
+        let mut n = jumps as u32;
+        let mut i = 0;
+        while i < segs.len() {
+            n += segs[i].n;
+            i += 1;
+        }
+        n
+    }
+
+    /// The input where the sweep starts: the first sine segment's start.
+    fn start(sw: Sweep, segs: &[Segment]) -> f32 {
+        sw.off + segs.iter().find(|s| s.per > 0.0).map_or(0.0, |s| sw.amp * s.gain * micromath::F32Ext::sin(s.phase))
+    }
+
+    /// Visit every sample of the segments with exact kinematics (x, ẋ, ẍ of a sine that
+    /// continues from the previous segment's last input), then the jumps (with the rate a
+    /// backward difference gives).
+    fn for_each_sample(sw: Sweep, segs: &[Segment], jumps: &[f32], mut f: impl FnMut(Kin)) {
+        use micromath::F32Ext;
+        let mut x = start(sw, segs);
+        for seg in segs {
+            let w = if seg.per > 0.0 { 2.0 * core::f32::consts::PI / seg.per } else { 0.0 };
+            let (c, s) = (w.cos(), w.sin());
+            let omega = w / DT;
+            let (mut sn, mut cs) = (seg.phase.sin(), seg.phase.cos());
+            let amp = sw.amp * seg.gain;
+            let base = x - amp * sn;
+            for _ in 0..seg.n {
+                (sn, cs) = (sn * c + cs * s, cs * c - sn * s);
+                x = base + amp * sn;
                 let u = sw.u_off + sw.u_amp * (0.5 + 0.5 * cs);
                 f(Kin::new(x, amp * omega * cs, -amp * omega * omega * sn, u));
-                prev = x;
-                k += 1;
             }
         }
-        for j in JUMPS {
-            let x = sw.off + j * sw.amp;
-            f(Kin::new(x, (x - prev) / DT, 0.0, sw.u_off + sw.u_amp));
-            prev = x;
+        for j in jumps {
+            let next = sw.off + j * sw.amp;
+            f(Kin::new(next, (next - x) / DT, 0.0, sw.u_off + sw.u_amp));
+            x = next;
         }
-        let _ = k;
     }
 
     fn fail(what: &str) -> ! {
@@ -107,7 +130,7 @@ mod bench {
         loop {}
     }
 
-    /// Measure `M::step` over the sweep.
+    /// Measure `M::step` over the envelope, then (as `outside`) beyond it.
     fn model<M: Model>(flat: &[f32], sw: Sweep) {
         let m = match M::from_params(flat, DT) {
             Ok(m) => m,
@@ -117,11 +140,13 @@ mod bench {
             }
         };
         let step: fn(&M, &mut M::State, &Kin) -> f32 = black_box(<M as Model>::step);
-        hprintln!("step {} {:#x} {}", M::ID, step as usize, CALLS);
-        let mut s = m.initial_state(&Kin::new(sw.off, 0.0, 0.0, sw.u_off));
-        for_each_sample(sw, |k| {
-            black_box(step(black_box(&m), &mut s, black_box(&k)));
-        });
+        for (kind, segs, jumps) in [("step", &ENVELOPE[..], &[][..]), ("outside", &OUTSIDE[..], &JUMPS[..])] {
+            hprintln!("{} {} {:#x} {}", kind, M::ID, step as usize, calls(segs, jumps.len()));
+            let mut s = m.initial_state(&Kin::new(start(sw, segs), 0.0, 0.0, sw.u_off));
+            for_each_sample(sw, segs, jumps, |k| {
+                black_box(step(black_box(&m), &mut s, black_box(&k)));
+            });
+        }
     }
 
     const fn sw(amp: f32, off: f32) -> Sweep {

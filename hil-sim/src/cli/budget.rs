@@ -33,10 +33,7 @@ pub fn run(a: BudgetArgs) -> anyhow::Result<()> {
     eprintln!("tracing {} on QEMU mps2-an386 (a minute or two)", elf.display());
     let report = budget::measure(&tools, &elf)?;
     if a.json {
-        let steps: Vec<_> = report
-            .steps
-            .iter()
-            .map(|s| {
+        let fig = |s: &budget::StepFigures| {
                 json!({
                     "name": s.name,
                     "stack_bytes": s.stack_bytes,
@@ -48,8 +45,9 @@ pub fn run(a: BudgetArgs) -> anyhow::Result<()> {
                     "budget": s.budget.map(|b| json!({"instructions": b.instructions, "stack_bytes": b.stack_bytes})),
                     "within_budget": s.budget.map(|_| s.excess().is_empty()),
                 })
-            })
-            .collect();
+        };
+        let steps: Vec<_> = report.steps.iter().filter(|s| !s.outside).map(fig).collect();
+        let outside: Vec<_> = report.steps.iter().filter(|s| s.outside).map(fig).collect();
         super::print_json(&json!({
             "machine": report.machine,
             "elf": report.elf,
@@ -57,6 +55,7 @@ pub fn run(a: BudgetArgs) -> anyhow::Result<()> {
             "core_hz": budget::CORE_HZ,
             "traced_instructions": report.traced_instructions,
             "steps": steps,
+            "outside_envelope": outside,
         }))?;
     } else {
         super::emit(&budget::table(&report));
