@@ -77,6 +77,29 @@ pub fn abs(x: f32) -> f32 {
     libm::fabsf(x)
 }
 
+/// Sign with `sign(0) = 0` (the papers' `sign`), NaN maps to 0.
+#[inline(always)]
+pub fn sign(x: f32) -> f32 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+/// Clamp that never panics (unlike `f32::clamp` with `lo > hi`); NaN maps to `lo`.
+#[inline(always)]
+pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
+    if x > hi {
+        hi
+    } else if x >= lo {
+        x
+    } else {
+        lo
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -99,27 +122,5 @@ mod tests {
         assert_eq!(tanh_fast(0.0), 0.0);
         assert_eq!(tanh_fast(-30.0), -1.0);
         assert!(tanh_fast(f32::NAN).is_nan());
-    }
-}
-/// Sign with `sign(0) = 0` (the papers' `sign`), NaN maps to 0.
-#[inline(always)]
-pub fn sign(x: f32) -> f32 {
-    if x > 0.0 {
-        1.0
-    } else if x < 0.0 {
-        -1.0
-    } else {
-        0.0
-    }
-}
-/// Clamp that never panics (unlike `f32::clamp` with `lo > hi`); NaN maps to `lo`.
-#[inline(always)]
-pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
-    if x > hi {
-        hi
-    } else if x >= lo {
-        x
-    } else {
-        lo
     }
 }

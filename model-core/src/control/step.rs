@@ -283,7 +283,9 @@ impl<M: Model> ControlStep<M> {
                 let t_static = |bb: f32| finite_or(static_output(model, &s.est.model, bb, i) * scale, 0.0);
                 let r_eff = r.max(t_static(0.0));
                 let start = clamp(finite_or(s.b_star, 0.0), 0.0, c.b_max);
-                let b_star = invert(t_static, r_eff, start, 0.0, c.b_max, 4, 1e-3 * c.b_max);
+                // One Newton step per sample from the last solution: the reference moves
+                // little in one period, so this tracks the root (bounded work per sample).
+                let b_star = invert(t_static, r_eff, start, 0.0, c.b_max, 1, 1e-3 * c.b_max);
                 s.b_star = b_star;
                 let i_ff = b_star / c.b_per_amp;
                 let lead = c.ff_lead_s * (i_ff - s.i_ff) / c.dt;

@@ -515,7 +515,8 @@ impl Model for BoucWen {
         let dx = k.x - s.x_prev;
         let l = abs(dx);
         // NaN anywhere (and n ≠ 1: fast_q = ∞) fails the test and takes the exact path.
-        if !(self.fast_q * l + self.turn_k * abs(k.ddx) <= FAST_Y) {
+        let short = self.fast_q * l + self.turn_k * abs(k.ddx) <= FAST_Y;
+        if !short {
             return self.step_exact(s, k);
         }
         // Region of w = sgn(Δx)·z: q = γ + β·sgn(w) (the sign bit of Δx·z₀ picks it);

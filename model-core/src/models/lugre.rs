@@ -160,7 +160,8 @@ impl Model for LuGre {
         let l = abs(dx);
         let y = self.alpha * l;
         // NaN anywhere fails the test and takes the exact path.
-        if !(y + self.turn_k * abs(k.ddx) <= FAST_Y) {
+        let short = y + self.turn_k * abs(k.ddx) <= FAST_Y;
+        if !short {
             return self.step_exact(s, k);
         }
         // z₀ + (s − z₀)(1 − e^{−y}) = z₀ + (α·ΔB − y·z₀)·φ(y): a convex combination of z₀
