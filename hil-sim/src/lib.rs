@@ -8,6 +8,7 @@ pub mod compare;
 pub mod data;
 pub mod dispatch;
 pub mod excitation;
+pub mod export;
 pub mod fit;
 pub mod fit_report;
 pub mod metrics;
