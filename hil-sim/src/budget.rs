@@ -110,7 +110,8 @@ const fn c(min: u32, max: u32) -> Cycles {
     Cycles { min, max }
 }
 
-const CONDS: [&str; 16] = ["eq", "ne", "cs", "hs", "cc", "lo", "mi", "pl", "vs", "vc", "hi", "ls", "ge", "lt", "gt", "le"];
+const CONDS: [&str; 16] =
+    ["eq", "ne", "cs", "hs", "cc", "lo", "mi", "pl", "vs", "vc", "hi", "ls", "ge", "lt", "gt", "le"];
 
 /// Registers in a `{r4, r5, lr}` / `{d8-d15}` list, in 32-bit words (a `d` register is 2).
 fn reg_words(operands: &str) -> (u32, bool) {
@@ -423,8 +424,7 @@ pub struct Tools {
 }
 
 fn on_path(name: &str) -> Option<PathBuf> {
-    std::env::var_os("PATH")
-        .and_then(|p| std::env::split_paths(&p).map(|d| d.join(name)).find(|p| p.is_file()))
+    std::env::var_os("PATH").and_then(|p| std::env::split_paths(&p).map(|d| d.join(name)).find(|p| p.is_file()))
 }
 
 impl Tools {

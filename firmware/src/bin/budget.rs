@@ -35,11 +35,11 @@ mod bench {
 
     use cortex_m_rt::entry;
     use cortex_m_semihosting::{debug, hprintln};
-    use model_core::control::{ControlConfig, ControlInput, ControlOutput, ControlState, ControlStep, LoopMode};
     use model_core::control::ValidatedConfig;
+    use model_core::control::{ControlConfig, ControlInput, ControlOutput, ControlState, ControlStep, LoopMode};
     use model_core::models::{
-        algebraic, arctan, arctan_inertia, bingham, bouc_wen, bouc_wen_asym, dahl, gpi, hammerstein_wiener,
-        lugre, maxwell_slip, narx, prandtl_ishlinskii, preisach, spencer, tanh, trig,
+        algebraic, arctan, arctan_inertia, bingham, bouc_wen, bouc_wen_asym, dahl, gpi, hammerstein_wiener, lugre,
+        maxwell_slip, narx, prandtl_ishlinskii, preisach, spencer, tanh, trig,
     };
     use model_core::rate::RateParams;
     use model_core::{Kin, Model};
@@ -222,10 +222,7 @@ mod bench {
             p[12 + i] = 0.5 / (1.0 + i as f32);
         }
         model::<prandtl_ishlinskii::Registered>(&p, sw(0.9, 0.0));
-        model::<gpi::Registered>(
-            &[1.0, 0.1, 1.0, 1.0, 1.0, 0.5, 0.2, 1.0, 0.5, 0.2, -1.0, 1.0, 0.0],
-            sw(0.9, 0.0),
-        );
+        model::<gpi::Registered>(&[1.0, 0.1, 1.0, 1.0, 1.0, 0.5, 0.2, 1.0, 0.5, 0.2, -1.0, 1.0, 0.0], sw(0.9, 0.0));
         let mut p = [0.0f32; 22];
         p[0] = 0.1;
         for i in 0..10 {
@@ -234,10 +231,7 @@ mod bench {
         }
         p[21] = 0.2;
         model::<maxwell_slip::Registered>(&p, sw(0.9, 0.0));
-        model::<bouc_wen_asym::Registered>(
-            &[0.5, 1.0, 1.0, 1.0, 0.5, 0.5, 1.0, 0.0, 0.5, 0.5, 0.5, 1.0],
-            sw(0.9, 0.0),
-        );
+        model::<bouc_wen_asym::Registered>(&[0.5, 1.0, 1.0, 1.0, 0.5, 0.5, 1.0, 0.0, 0.5, 0.5, 0.5, 1.0], sw(0.9, 0.0));
     }
 
     type Step = ControlStep<algebraic::Algebraic>;

@@ -26,7 +26,9 @@ pub fn run(a: BudgetArgs) -> anyhow::Result<()> {
     let elf = match a.elf {
         Some(p) => p,
         None => {
-            eprintln!("building the bench (cargo build --release -p firmware --target thumbv7em-none-eabihf --bin budget)");
+            eprintln!(
+                "building the bench (cargo build --release -p firmware --target thumbv7em-none-eabihf --bin budget)"
+            );
             budget::build_bench(&budget::workspace_root())?
         }
     };
@@ -34,17 +36,17 @@ pub fn run(a: BudgetArgs) -> anyhow::Result<()> {
     let report = budget::measure(&tools, &elf)?;
     if a.json {
         let fig = |s: &budget::StepFigures| {
-                json!({
-                    "name": s.name,
-                    "stack_bytes": s.stack_bytes,
-                    "instructions": s.instructions,
-                    "mean_instructions": (s.mean_instructions * 10.0).round() / 10.0,
-                    "cycles_min": s.cycles_min,
-                    "cycles_max": s.cycles_max,
-                    "calls": s.calls,
-                    "budget": s.budget.map(|b| json!({"instructions": b.instructions, "stack_bytes": b.stack_bytes})),
-                    "within_budget": s.budget.map(|_| s.excess().is_empty()),
-                })
+            json!({
+                "name": s.name,
+                "stack_bytes": s.stack_bytes,
+                "instructions": s.instructions,
+                "mean_instructions": (s.mean_instructions * 10.0).round() / 10.0,
+                "cycles_min": s.cycles_min,
+                "cycles_max": s.cycles_max,
+                "calls": s.calls,
+                "budget": s.budget.map(|b| json!({"instructions": b.instructions, "stack_bytes": b.stack_bytes})),
+                "within_budget": s.budget.map(|_| s.excess().is_empty()),
+            })
         };
         let steps: Vec<_> = report.steps.iter().filter(|s| !s.outside).map(fig).collect();
         let outside: Vec<_> = report.steps.iter().filter(|s| s.outside).map(fig).collect();
