@@ -176,11 +176,13 @@ pub fn cycles_of(mnemonic: &str, operands: &str) -> Cycles {
     if ["ldr", "ldrb", "ldrh", "ldrsb", "ldrsh", "str", "strb", "strh", "ldrex", "strex"].iter().any(|n| is(n)) {
         return if writes_pc && base.starts_with("ldr") { c(3, 5) } else { c(1, 2) };
     }
-    if is("bl") || is("blx") || is("bx") {
-        return c(2, 4);
-    }
-    if is("b") || is("cbz") || is("cbnz") {
+    // Branches take a condition but no `s`: `bls` is `b` + `ls`, not `bl` + `s`.
+    let branch = |name: &str| base == name || base.strip_prefix(name).is_some_and(|rest| CONDS.contains(&rest));
+    if branch("b") || branch("cbz") || branch("cbnz") {
         return c(1, 4);
+    }
+    if branch("bl") || branch("blx") || branch("bx") {
+        return c(2, 4);
     }
     if is("tbb") || is("tbh") {
         return c(3, 5);
