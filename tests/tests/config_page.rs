@@ -4,7 +4,8 @@
 
 use hil_sim::export;
 use hil_sim::params_file::ParamsFile;
-use model_core::control::{ConfigImage, RateSpec};
+use model_core::control::config::WORDS;
+use model_core::control::{ConfigImage, PageError, RateSpec};
 use model_core::models::spencer::Spencer;
 use model_core::Model;
 use std::path::Path;
@@ -25,10 +26,11 @@ fn export_round_trips_through_the_firmware_decoder() {
     let mut p = vec![0.0; Spencer::N_PARAMS];
     m.write_params(&mut p);
     assert_eq!(p, back.params());
-    // A flipped bit anywhere in the parameters is caught by the page CRC.
+    // A flipped bit in the model parameters (after the 48-byte header and the control
+    // words) is caught by the page CRC.
     let mut bad = bytes;
-    bad[300] ^= 4;
-    assert!(ConfigImage::decode(&bad).is_err());
+    bad[48 + 4 * WORDS + 4 * 3 + 1] ^= 4;
+    assert!(matches!(ConfigImage::decode(&bad), Err(PageError::CrcMismatch { .. })));
 }
 
 #[test]
