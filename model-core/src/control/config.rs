@@ -487,10 +487,8 @@ impl Scrub {
     /// fingerprint matched, otherwise `None`.
     #[inline]
     pub fn step(&mut self, cfg: &ValidatedConfig) -> Option<bool> {
-        let start = usize::from(self.pos);
-        for i in start..(start + SCRUB_WORDS).min(WORDS) {
-            self.acc = fingerprint_step(self.acc, cfg.cfg.word(i));
-        }
+        let block = usize::from(self.pos) / SCRUB_WORDS;
+        self.acc = cfg.cfg.fold_block(block, self.acc);
         self.pos = self.pos.saturating_add(SCRUB_WORDS as u16);
         if usize::from(self.pos) >= WORDS {
             let ok = self.acc == cfg.fingerprint;
@@ -499,6 +497,29 @@ impl Scrub {
         } else {
             None
         }
+    }
+}
+
+impl ControlConfig {
+    /// Fold words `8·block .. 8·block + 8` (those that exist) into the fingerprint. The
+    /// array is taken apart by a pattern with constant positions, so the compiler reads
+    /// only the eight fields of the block (no copy of the whole configuration).
+    #[inline(always)]
+    fn fold_block(&self, block: usize, acc: u32) -> u32 {
+        let [w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, w36, w37, w38, w39, w40, w41, w42, w43] =
+            self.to_words();
+        let ws: [f32; SCRUB_WORDS] = match block {
+            0 => [w0, w1, w2, w3, w4, w5, w6, w7],
+            1 => [w8, w9, w10, w11, w12, w13, w14, w15],
+            2 => [w16, w17, w18, w19, w20, w21, w22, w23],
+            3 => [w24, w25, w26, w27, w28, w29, w30, w31],
+            4 => [w32, w33, w34, w35, w36, w37, w38, w39],
+            _ => {
+                // The last block has four words: fold just those.
+                return [w40, w41, w42, w43].iter().fold(acc, |a, w| fingerprint_step(a, *w));
+            }
+        };
+        ws.iter().fold(acc, |a, w| fingerprint_step(a, *w))
     }
 }
 
