@@ -268,7 +268,7 @@ impl PageAssembler {
 
 #[cfg(test)]
 mod tests {
-    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+    #![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::panic)]
     use super::*;
     use crate::control::page::RateSpec;
     use crate::control::ControlConfig;
