@@ -51,6 +51,29 @@ pub enum RateChoice {
 }
 
 impl RateChoice {
+    /// `backward`, `filtered:FC_HZ`, `kalman` (seed 002's q = 200, r = 0.01) or `kalman:Q:R`.
+    pub fn parse(s: &str) -> Result<Self, String> {
+        let parts: Vec<&str> = s.split(':').collect();
+        let num = |p: &str| p.parse::<f32>().map_err(|_| format!("--rate {s}: `{p}` is not a number"));
+        Ok(match parts.as_slice() {
+            ["backward"] => Self::Backward,
+            ["filtered", fc] => Self::Filtered(num(fc)?),
+            ["kalman"] => Self::Kalman { q: 200.0, r: 0.01 },
+            ["kalman", q, r] => Self::Kalman { q: num(q)?, r: num(r)? },
+            _ => return Err(format!("--rate {s}: expected backward, filtered:FC_HZ or kalman[:Q:R]")),
+        })
+    }
+
+    /// The form the firmware's configuration page stores.
+    pub fn spec(self) -> model_core::control::RateSpec {
+        use model_core::control::RateSpec;
+        match self {
+            Self::Backward => RateSpec::Backward,
+            Self::Filtered(fc) => RateSpec::Filtered { fc },
+            Self::Kalman { q, r } => RateSpec::Kalman { q, r },
+        }
+    }
+
     pub fn build(self, dt: f32) -> Result<RateParams, ParamError> {
         match self {
             Self::Backward => RateParams::backward(dt),

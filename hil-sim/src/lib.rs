@@ -3,11 +3,13 @@
 
 pub mod accuracy;
 pub mod alignment;
+pub mod budget;
 pub mod closed_loop;
 pub mod compare;
 pub mod data;
 pub mod dispatch;
 pub mod excitation;
+pub mod export;
 pub mod fit;
 pub mod fit_report;
 pub mod metrics;

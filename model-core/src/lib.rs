@@ -18,6 +18,7 @@ pub mod kinematics;
 pub mod math;
 pub mod model;
 pub mod models;
+pub mod protocol;
 pub mod rate;
 pub mod registry;
 

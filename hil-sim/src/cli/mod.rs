@@ -2,8 +2,10 @@
 //! then stdout carries exactly one JSON object; progress and logs go to stderr.
 
 mod accuracy;
+mod budget;
 mod compare;
 mod demo;
+mod export;
 mod fit;
 mod loop_cmd;
 mod models;
@@ -12,7 +14,7 @@ mod simulate;
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context};
+use anyhow::bail;
 use clap::{Args, Parser, Subcommand};
 use hil_sim::dispatch::RateChoice;
 use hil_sim::replay::Channels;
@@ -42,6 +44,10 @@ pub enum Cmd {
     Simulate(simulate::SimulateArgs),
     /// Closed loop: the firmware's control step against the simulated clutch.
     Loop(loop_cmd::LoopArgs),
+    /// Instructions, cycles and stack per step on the Cortex-M4F (QEMU mps2-an386).
+    Budget(budget::BudgetArgs),
+    /// Write a parameter file (`fit --save`) as the firmware's flash configuration page.
+    Export(export::ExportArgs),
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
@@ -54,6 +60,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Cmd::Demo(a) => demo::run(a),
         Cmd::Simulate(a) => simulate::run_cmd(a),
         Cmd::Loop(a) => loop_cmd::run_cmd(a),
+        Cmd::Budget(a) => budget::run(a),
+        Cmd::Export(a) => export::run(a),
     }
 }
 
@@ -102,15 +110,7 @@ impl ChannelArgs {
 }
 
 pub fn parse_rate(s: &str) -> anyhow::Result<RateChoice> {
-    let parts: Vec<&str> = s.split(':').collect();
-    let num = |p: &str| p.parse::<f32>().with_context(|| format!("--rate {s}: `{p}` is not a number"));
-    Ok(match parts.as_slice() {
-        ["backward"] => RateChoice::Backward,
-        ["filtered", fc] => RateChoice::Filtered(num(fc)?),
-        ["kalman"] => RateChoice::Kalman { q: 200.0, r: 0.01 },
-        ["kalman", q, r] => RateChoice::Kalman { q: num(q)?, r: num(r)? },
-        _ => bail!("--rate {s}: expected backward, filtered:FC_HZ or kalman[:Q:R]"),
-    })
+    RateChoice::parse(s).map_err(anyhow::Error::msg)
 }
 
 /// Print one JSON object on stdout.

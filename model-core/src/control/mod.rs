@@ -8,16 +8,19 @@
 //! sample for implausible readings and latches a fault code; any fault ends in the safe
 //! state (PWM off, bridge high-impedance so the coil de-energises through the diodes).
 //! Settings are a [`config::ValidatedConfig`]: validated once, CRC-protected, swapped in
-//! between samples by replacing a `Copy` value.
+//! between samples by replacing a `Copy` value. The flash page that holds the model, its
+//! parameters and these settings is [`page`].
 
 pub mod calibration;
 pub mod config;
 pub mod feedforward;
+pub mod page;
 pub mod pi;
 pub mod pwm;
 pub mod step;
 pub mod supervisor;
 
 pub use config::{ControlConfig, LoopMode, ValidatedConfig};
+pub use page::{ConfigImage, PageError, RateSpec};
 pub use step::{ControlInput, ControlOutput, ControlState, ControlStep, Mode};
 pub use supervisor::FaultCode;

@@ -281,9 +281,12 @@ impl<M: Model> ControlStep<M> {
         let i_ref = match c.mode {
             LoopMode::Torque => {
                 let t_static = |bb: f32| finite_or(static_output(model, &s.est.model, bb, i) * scale, 0.0);
-                let r_eff = r.max(t_static(0.0));
+                let t0 = t_static(0.0);
+                let r_eff = if r > t0 { r } else { t0 };
                 let start = clamp(finite_or(s.b_star, 0.0), 0.0, c.b_max);
-                let b_star = invert(t_static, r_eff, start, 0.0, c.b_max, 4, 1e-3 * c.b_max);
+                // One Newton step per sample from the last solution: the reference moves
+                // little in one period, so this tracks the root (bounded work per sample).
+                let b_star = invert(t_static, r_eff, start, 0.0, c.b_max, 1, 1e-3 * c.b_max);
                 s.b_star = b_star;
                 let i_ff = b_star / c.b_per_amp;
                 let lead = c.ff_lead_s * (i_ff - s.i_ff) / c.dt;
@@ -294,7 +297,8 @@ impl<M: Model> ControlStep<M> {
             LoopMode::OpenLoopTorque => StaticMap { a: c.map }.current(r, c.i_max),
             LoopMode::Current => r,
         };
-        let v_lim = c.duty_max * finite_or(x.supply_v, 0.0).max(0.0);
+        let supply = finite_or(x.supply_v, 0.0);
+        let v_lim = c.duty_max * if supply > 0.0 { supply } else { 0.0 };
         let pi_i = Pi::new(c.kp_i, c.ki_i, c.dt, -v_lim, v_lim);
         let demag = Demag { duty: c.demag_duty, samples: c.demag_samples as u16, threshold: c.demag_threshold };
         let (v, d) = match demag.step(&mut s.demag, r, i) {

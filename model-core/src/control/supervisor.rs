@@ -105,8 +105,9 @@ pub struct SupState {
     pub stuck: u16,
     pub open: u16,
     pub band: u16,
-    /// Slew violations of the last 8 samples, one bit each.
+    /// Slew violations of the last 8 samples, one bit each, and how many are set.
     pub slew_hist: u8,
+    pub slew_n: u8,
     /// Last Hall change that exceeded the slew limit, T.
     pub last_jump: f32,
     pub last_hall: u16,
@@ -121,18 +122,17 @@ fn count(c: &mut u16, cond: bool) -> u16 {
 }
 
 /// Run every check; the first that trips, in a fixed priority order, is returned.
+#[inline(always)]
 pub fn check(cfg: &ControlConfig, s: &mut SupState, o: &Observation) -> FaultCode {
-    let confirm = cfg.confirm_samples as u16;
     let abs = crate::math::abs;
     let hall = f32::from(o.hall);
-    let rail_hi = count(&mut s.rail_hi, hall >= cfg.hall_rail_hi) >= confirm;
-    let rail_lo = count(&mut s.rail_lo, hall <= cfg.hall_rail_lo) >= confirm;
     let supply_ok = o.supply_v.is_finite();
-    let supply_lo = count(&mut s.supply_lo, !supply_ok || o.supply_v < cfg.v_min) >= confirm;
-    let supply_hi = count(&mut s.supply_hi, supply_ok && o.supply_v > cfg.v_max) >= confirm;
-    let over = count(&mut s.over, !o.i.is_finite() || abs(o.i) > cfg.over_current) >= confirm;
-    let model = count(&mut s.model, o.running && o.model_bad) >= confirm;
-    let overrun = count(&mut s.overrun, o.overrun) >= confirm;
+    let c_rail_hi = hall >= cfg.hall_rail_hi;
+    let c_rail_lo = hall <= cfg.hall_rail_lo;
+    let c_supply_lo = !supply_ok || o.supply_v < cfg.v_min;
+    let c_supply_hi = supply_ok && o.supply_v > cfg.v_max;
+    let c_over = !o.i.is_finite() || abs(o.i) > cfg.over_current;
+    let c_model = o.running && o.model_bad;
     // Noise reverses direction; a real field change (even a collapse when the coil
     // opens) moves one way. A violation is a jump beyond the slew limit that reverses the
     // previous one.
@@ -142,18 +142,29 @@ pub fn check(cfg: &ControlConfig, s: &mut SupState, o: &Observation) -> FaultCod
     if big {
         s.last_jump = db;
     }
-    s.slew_hist = (s.slew_hist << 1) | u8::from(slew && o.running);
-    let noise = s.slew_hist.count_ones() >= cfg.slew_count as u32;
+    let new = u8::from(slew && o.running);
+    s.slew_n = s.slew_n.wrapping_add(new).wrapping_sub(s.slew_hist >> 7);
+    s.slew_hist = (s.slew_hist << 1) | new;
+    let noise = u32::from(s.slew_n) >= cfg.slew_count as u32;
     let frozen = s.primed && o.hall == s.last_hall && o.running;
-    let stuck = cfg.stuck_samples > 0.0 && f32::from(count(&mut s.stuck, frozen)) >= cfg.stuck_samples;
-    let open_cond = o.running && abs(o.v_applied) > cfg.open_v && abs(o.i) < cfg.open_i;
-    let open = f32::from(count(&mut s.open, open_cond)) >= cfg.open_samples;
-    let band_cond = o.running && cfg.b_band > 0.0 && abs(o.b - cfg.b_per_amp * o.i) > cfg.b_band;
-    let band = f32::from(count(&mut s.band, band_cond)) >= cfg.band_samples;
+    let c_open = o.running && abs(o.v_applied) > cfg.open_v && abs(o.i) < cfg.open_i;
+    let c_band = o.running && cfg.b_band > 0.0 && abs(o.b - cfg.b_per_amp * o.i) > cfg.b_band;
     s.last_hall = o.hall;
     s.last_b = o.b;
     s.primed = true;
-    if o.crc_ok == Some(false) {
+    let crc_bad = o.crc_ok == Some(false);
+    let confirm = cfg.confirm_samples as u16;
+    let rail_hi = count(&mut s.rail_hi, c_rail_hi) >= confirm;
+    let rail_lo = count(&mut s.rail_lo, c_rail_lo) >= confirm;
+    let supply_lo = count(&mut s.supply_lo, c_supply_lo) >= confirm;
+    let supply_hi = count(&mut s.supply_hi, c_supply_hi) >= confirm;
+    let over = count(&mut s.over, c_over) >= confirm;
+    let model = count(&mut s.model, c_model) >= confirm;
+    let overrun = count(&mut s.overrun, o.overrun) >= confirm;
+    let stuck = cfg.stuck_samples > 0.0 && f32::from(count(&mut s.stuck, frozen)) >= cfg.stuck_samples;
+    let open = f32::from(count(&mut s.open, c_open)) >= cfg.open_samples;
+    let band = f32::from(count(&mut s.band, c_band)) >= cfg.band_samples;
+    if crc_bad {
         FaultCode::ConfigCrc
     } else if rail_hi {
         FaultCode::HallOpen

@@ -1,0 +1,78 @@
+//! `hil-sim budget`: instructions, cycles and stack per model step and control step on the
+//! Cortex-M4F (method in `hil_sim::budget`).
+
+use std::path::PathBuf;
+
+use anyhow::bail;
+use clap::Args;
+use hil_sim::budget::{self, Tools};
+use serde_json::json;
+
+#[derive(Args, Debug)]
+pub struct BudgetArgs {
+    /// A prebuilt bench ELF (`firmware/src/bin/budget.rs` for thumbv7em-none-eabihf,
+    /// release). Default: build it with cargo in this workspace.
+    #[arg(long)]
+    pub elf: Option<PathBuf>,
+    /// Exit non-zero, naming the step, when a step exceeds its budget's ceiling (the target,
+    /// or for a step that misses its target, the guard just above today's figure).
+    #[arg(long)]
+    pub check: bool,
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(a: BudgetArgs) -> anyhow::Result<()> {
+    let tools = Tools::find()?;
+    let elf = match a.elf {
+        Some(p) => p,
+        None => {
+            eprintln!(
+                "building the bench (cargo build --release -p firmware --target thumbv7em-none-eabihf --bin budget)"
+            );
+            budget::build_bench(&budget::workspace_root())?
+        }
+    };
+    eprintln!("tracing {} on QEMU mps2-an386 (a minute or two)", elf.display());
+    let report = budget::measure(&tools, &elf)?;
+    if a.json {
+        let fig = |s: &budget::StepFigures| {
+            json!({
+                "name": s.name,
+                "stack_bytes": s.stack_bytes,
+                "instructions": s.instructions,
+                "mean_instructions": (s.mean_instructions * 10.0).round() / 10.0,
+                "cycles_min": s.cycles_min,
+                "cycles_max": s.cycles_max,
+                "calls": s.calls,
+                "budget": s.budget.map(|b| json!({
+                    "instructions": b.instructions, "stack_bytes": b.stack_bytes,
+                    "ceiling_instructions": b.ceiling_instructions, "ceiling_stack_bytes": b.ceiling_stack_bytes,
+                })),
+                "within_budget": s.budget.map(|_| s.excess().is_empty()),
+            })
+        };
+        let steps: Vec<_> = report.steps.iter().filter(|s| !s.outside).map(fig).collect();
+        let outside: Vec<_> = report.steps.iter().filter(|s| s.outside).map(fig).collect();
+        super::print_json(&json!({
+            "machine": report.machine,
+            "elf": report.elf,
+            "control_hz": budget::CONTROL_HZ,
+            "core_hz": budget::CORE_HZ,
+            "traced_instructions": report.traced_instructions,
+            "steps": steps,
+            "outside_envelope": outside,
+        }))?;
+    } else {
+        super::emit(&budget::table(&report));
+    }
+    let missed = report.exceeded();
+    if !missed.is_empty() {
+        eprintln!("warning: over target: {}", missed.join("; "));
+    }
+    let over = report.over_ceiling();
+    if a.check && !over.is_empty() {
+        bail!("over budget: {}", over.join("; "));
+    }
+    Ok(())
+}

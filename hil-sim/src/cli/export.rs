@@ -1,0 +1,55 @@
+//! `hil-sim export PARAMS.json --out config.bin`: the firmware's configuration page.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+use hil_sim::export;
+use hil_sim::params_file::ParamsFile;
+use serde_json::json;
+
+#[derive(Args, Debug)]
+pub struct ExportArgs {
+    /// Parameter file (`fit --save DIR` writes one per model).
+    pub params: PathBuf,
+    /// Where to write the page (2048 bytes).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Control-step rate of the firmware, Hz (the model's time step is its inverse).
+    #[arg(long, default_value_t = export::CONTROL_HZ)]
+    pub control_hz: f32,
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(a: ExportArgs) -> anyhow::Result<()> {
+    let path = super::file_arg(&a.params)?;
+    let file = ParamsFile::read(&path)?;
+    let control = export::default_control(a.control_hz)?;
+    let img = export::image(&file, &path, control)?;
+    let bytes = img.encode();
+    std::fs::write(&a.out, bytes).with_context(|| format!("writing {}", a.out.display()))?;
+    let len = u16::from_le_bytes([bytes[6], bytes[7]]);
+    let crc = u32::from_le_bytes([
+        bytes[usize::from(len)],
+        bytes[usize::from(len) + 1],
+        bytes[usize::from(len) + 2],
+        bytes[usize::from(len) + 3],
+    ]);
+    if a.json {
+        super::print_json(&json!({
+            "out": a.out, "model": img.model_id(), "n_params": img.params().len(),
+            "bytes": bytes.len(), "crc_covered_bytes": len, "crc": format!("{crc:#010x}"),
+            "control_hz": a.control_hz,
+        }))
+    } else {
+        super::emit(&format!(
+            "{}: {} ({} parameters), {} bytes, CRC-32 {crc:#010x} over {len} bytes\n",
+            a.out.display(),
+            img.model_id(),
+            img.params().len(),
+            bytes.len()
+        ));
+        Ok(())
+    }
+}
