@@ -25,6 +25,17 @@ pub struct ExportArgs {
 pub fn run(a: ExportArgs) -> anyhow::Result<()> {
     let path = super::file_arg(&a.params)?;
     let file = ParamsFile::read(&path)?;
+    // The delays align a recording's channels; the board samples its sensors itself.
+    for (name, d) in [("delay_s", file.delay_s), ("command_delay_s", file.command_delay_s)] {
+        if let Some(d) = d.filter(|d| *d != 0.0) {
+            eprintln!(
+                "warning: {}: `{name}` = {:.3} ms aligns the recording's channels and is not part of the \
+                 configuration page",
+                path.display(),
+                1e3 * d
+            );
+        }
+    }
     let control = export::default_control(a.control_hz)?;
     let img = export::image(&file, &path, control)?;
     let bytes = img.encode();
