@@ -280,28 +280,21 @@ pub struct StepFigures {
 impl StepFigures {
     /// The reasons this step misses its budget (empty when within, or without one).
     pub fn excess(&self) -> Vec<String> {
-        let mut v = Vec::new();
-        if let Some(b) = self.budget {
-            if self.instructions > b.instructions {
-                v.push(format!("{} instructions > {}", self.instructions, b.instructions));
-            }
-            if self.stack_bytes > b.stack_bytes {
-                v.push(format!("{} B of stack > {} B", self.stack_bytes, b.stack_bytes));
-            }
-        }
-        v
+        self.budget.map_or_else(Vec::new, |b| self.beyond(b.instructions, b.stack_bytes))
     }
 
     /// The reasons this step exceeds the ceiling `--check` enforces (empty when within).
     pub fn over_ceiling(&self) -> Vec<String> {
+        self.budget.map_or_else(Vec::new, |b| self.beyond(b.ceiling_instructions, b.ceiling_stack_bytes))
+    }
+
+    fn beyond(&self, instructions: u64, stack_bytes: u32) -> Vec<String> {
         let mut v = Vec::new();
-        if let Some(b) = self.budget {
-            if self.instructions > b.ceiling_instructions {
-                v.push(format!("{} instructions > {}", self.instructions, b.ceiling_instructions));
-            }
-            if self.stack_bytes > b.ceiling_stack_bytes {
-                v.push(format!("{} B of stack > {} B", self.stack_bytes, b.ceiling_stack_bytes));
-            }
+        if self.instructions > instructions {
+            v.push(format!("{} instructions > {instructions}", self.instructions));
+        }
+        if self.stack_bytes > stack_bytes {
+            v.push(format!("{} B of stack > {stack_bytes} B", self.stack_bytes));
         }
         v
     }
@@ -536,21 +529,19 @@ pub struct Report {
 impl Report {
     /// Steps that miss their budget, with the reasons.
     pub fn exceeded(&self) -> Vec<String> {
-        self.steps
-            .iter()
-            .filter_map(|s| {
-                let e = s.excess();
-                (!e.is_empty()).then(|| format!("{}: {}", s.name, e.join(", ")))
-            })
-            .collect()
+        self.named(StepFigures::excess)
     }
 
     /// Steps over the ceiling `--check` enforces, with the reasons.
     pub fn over_ceiling(&self) -> Vec<String> {
+        self.named(StepFigures::over_ceiling)
+    }
+
+    fn named(&self, reasons: impl Fn(&StepFigures) -> Vec<String>) -> Vec<String> {
         self.steps
             .iter()
             .filter_map(|s| {
-                let e = s.over_ceiling();
+                let e = reasons(s);
                 (!e.is_empty()).then(|| format!("{}: {}", s.name, e.join(", ")))
             })
             .collect()
