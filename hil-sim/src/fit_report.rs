@@ -69,12 +69,19 @@ pub fn fit_plots(
     report.image(&name, &format!("{}: measured vs model, {:.1}–{:.1} s", r.model, t_split - 1.0, t_split + 2.0));
     let (la, lb) = span(t, t_split - 1.0, t_split + 0.5);
     let name = format!("{stem}_loop.svg");
+    // Against the input as the model saw it (shifted by the fitted delay).
+    let x = crate::alignment::shift(&data.input, r.delay_s / data.dt);
+    let x_label = if r.delay_s == 0.0 {
+        labels.input.clone()
+    } else {
+        format!("{} at t {:+.2} ms (fitted delay)", labels.input, 1e3 * r.delay_s)
+    };
     plot::hysteresis_loop(
         dir.join(&name),
         &format!("{}: hysteresis loop, {:.1}–{:.1} s", r.model, t_split - 1.0, t_split + 0.5),
-        &labels.input,
+        &x_label,
         &labels.output,
-        &data.input[la..lb],
+        &x[la..lb],
         &data.output[la..lb],
         &r.output[la..lb],
     )?;
