@@ -49,6 +49,12 @@ pub fn shift(x: &[f64], d: f64) -> Vec<f64> {
         .collect()
 }
 
+/// The input read `d` samples later and the command (if any) `d_u` samples later: the
+/// channels a model fitted with these delays is fed.
+pub fn shift_channels(x: &[f64], u: Option<&[f64]>, d: f64, d_u: f64) -> (Vec<f64>, Option<Vec<f64>>) {
+    (shift(x, d), u.map(|u| shift(u, d_u)))
+}
+
 /// The kinematics `x, ẋ, ẍ` read `d` samples later and the command `u` read `d_u` samples
 /// later. The rate estimators are linear and time-invariant, so this equals (up to the
 /// start-up transient and the interpolation) the kinematics of the shifted input; the fit

@@ -57,8 +57,7 @@ pub fn replay_recording(
     let u = ch.command.as_deref().map(|c| rec.channel(c)).transpose()?;
     let dt = rec.mean_dt(&ch.time)?;
     let (d, d_u) = (delays_s.0 / dt, if u.is_some() { delays_s.1 / dt } else { 0.0 });
-    let x = crate::alignment::shift(x, d);
-    let u = u.map(|u| crate::alignment::shift(u, d_u));
+    let (x, u) = crate::alignment::shift_channels(x, u, d, d_u);
     let samples = samples(&x, u.as_deref());
     let out = replay(model, params, dt as f32, rate, &samples)?;
     let model_output: Vec<f64> = out.y.iter().map(|v| f64::from(*v)).collect();

@@ -290,18 +290,16 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
 
     // Score with the Estimator path, the firmware's code, over the whole recording.
     let p32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
-    let samples = if delay == 0.0 && delay_u == 0.0 {
-        samples
-    } else {
-        let u = data.command.as_deref().map(|u| crate::alignment::shift(u, delay_u));
-        crate::replay::samples(&crate::alignment::shift(&data.input, delay), u.as_deref())
-    };
+    // The channels as the model saw them (as recorded when no delay was fitted).
+    let (input, command) = crate::alignment::shift_channels(&data.input, data.command.as_deref(), delay, delay_u);
+    let samples =
+        if delay == 0.0 && delay_u == 0.0 { samples } else { crate::replay::samples(&input, command.as_deref()) };
     let t0 = Instant::now();
     let rep = replay(id, &p32, dt, sp.rate, &samples)
         .map_err(|e| FitError::Replay { model: id.to_owned(), reason: e.to_string() })?;
     let replay_ns = t0.elapsed().as_secs_f64() * 1e9 / samples.len().max(1) as f64;
     let output: Vec<f64> = rep.y.iter().map(|v| f64::from(*v)).collect();
-    let dx = gradient(&data.input, data.dt);
+    let dx = gradient(&input, data.dt);
     let ddx = gradient(&dx, data.dt);
     let score = |rows: &[usize]| {
         let pick = |v: &[f64]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
@@ -313,8 +311,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     let unflagged: Vec<usize> = data.heldout_unflagged().into_iter().filter(|i| (lo..hi).contains(i)).collect();
     let all_heldout: Vec<usize> = (data.train_end..n).filter(|i| (lo..hi).contains(i)).collect();
     let rows: Vec<usize> = rows.into_iter().filter(|i| (lo..hi).contains(i)).collect();
-    let flat32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
-    let named = ParamsFile::from_flat(id, None, &flat32).map(|f| f.params).unwrap_or(Values::Flat(params.clone()));
+    let named = ParamsFile::from_flat(id, None, &p32).map(|f| f.params).unwrap_or(Values::Flat(params.clone()));
     Ok(FitResult {
         model: id.to_owned(),
         params: named,
@@ -416,7 +413,7 @@ where
         crate::alignment::shift_kin(kin, d, 0.0, &mut shifted);
         at(&shifted).map(|(r, c)| (r, c, d))
     };
-    let grid: Vec<Option<(T, f64, f64)>> = (-m..=m).into_par_iter().map(|d| fit_shifted(f64::from(d))).collect();
+    let mut grid: Vec<Option<(T, f64, f64)>> = (-m..=m).into_par_iter().map(|d| fit_shifted(f64::from(d))).collect();
     let cost_at = |i: usize| grid.get(i).and_then(|g| g.as_ref()).map_or(f64::INFINITY, |g| g.1);
     let best =
         (0..grid.len()).filter(|&i| cost_at(i).is_finite()).min_by(|&a, &b| cost_at(a).total_cmp(&cost_at(b)))?;
@@ -426,7 +423,6 @@ where
         let d = (best as f64 - f64::from(m)) + off.clamp(-0.5, 0.5);
         fit_shifted(d)
     });
-    let mut grid = grid;
     let coarse = grid.get_mut(best)?.take()?;
     let winner = match refined {
         Some(r) if r.1 < coarse.1 => r,
