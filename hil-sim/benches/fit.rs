@@ -50,6 +50,8 @@ fn bench(c: &mut Criterion) {
     for (id, p) in [
         ("algebraic", vec![100.0f32, 20.0, 1.0, -100.0]),
         ("bouc_wen", vec![500.0, 10.0, 10.0, 1.0, 2.0, 20.0, 5.0, 0.0]),
+        // Spencer et al. (1997) for this damper; the command channel Y drives it.
+        ("spencer", vec![21.0, 3.5, 46.9, 283.0, 2.95, 5.0, 14.3, 140.0, 695.0, 363.0, 363.0, 301.0, 2.0, 190.0]),
     ] {
         g.bench_function(id, |b| {
             b.iter(|| replay(id, &p, d.dt as f32, RateChoice::Backward, &samples).expect("replay"))

@@ -25,7 +25,7 @@ pub struct SwarmOptions {
 
 impl Default for SwarmOptions {
     fn default() -> Self {
-        Self { particles: 48, iterations: 20, seed: 1, keep: 3 }
+        Self { particles: 24, iterations: 12, seed: 1, keep: 2 }
     }
 }
 

@@ -116,7 +116,7 @@
 //! command sample, and whether the first sample has been seen.
 
 use crate::error::{check, count, finite, time_step};
-use crate::math::{abs, atan, exp, expm1, ln, powf, sin, sqrt, tanh};
+use crate::math::{abs, atan, exp, expm1, expm1_small, ln, powf, sin, sqrt, tanh_small as tanh};
 use crate::model::write_flat;
 use crate::{Finite, Kin, Model, ParamError};
 
@@ -302,10 +302,16 @@ impl Finite for State {
 pub type Registered = Spencer;
 
 /// θ of the exponentially fitted θ-method: `1/(1 − e^{−x}) − 1/x` (→ ½ as x → 0).
+///
+/// Below 1 (every stage of the published set and of the fits on the Dyke files) its
+/// Bernoulli series to x⁹, `½ + x/12 − x³/720 + x⁵/30240 − x⁷/1209600 + x⁹/47900160`
+/// (truncation < 6e-10), which needs neither `expm1` nor a division.
 #[inline]
 fn fitted_theta(x: f32) -> f32 {
-    if x < 1e-2 {
-        0.5 + x / 12.0
+    if x < 1.0 {
+        let x2 = x * x;
+        0.5 + x
+            * (1.0 / 12.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 30_240.0 + x2 * (-1.0 / 1_209_600.0 + x2 / 47_900_160.0))))
     } else if x > 30.0 {
         1.0 - 1.0 / x
     } else {
@@ -505,7 +511,13 @@ impl Spencer {
         }
         // Loading: dζ/dD = A − (β+γ)ζ², ζ(∞) = z_max.
         let r = self.zmax;
-        let t = tanh(self.q_load * d);
+        let x = self.q_load * d;
+        if abs(x) <= 0.25 {
+            // tanh = E/(E + 2) with E = e²ˣ − 1, folded into the one division.
+            let e = expm1_small(2.0 * x);
+            return r * (zeta * (e + 2.0) + r * e) / (r * (e + 2.0) + zeta * e);
+        }
+        let t = tanh(x);
         r * (zeta + r * t) / (r + zeta * t)
     }
 
@@ -589,18 +601,23 @@ impl Spencer {
     /// the stage is split there so that each part moves `w` one way. Returns `(w₁, z₁)`.
     #[inline]
     fn stage(&self, w0: f32, z0: f32, (hx0, hx1): (f32, f32), (u0, u1): (f32, f32), h: f32) -> (f32, f32) {
-        let (f0, f1) = self.drive(w0, z0, (hx0, hx1), (u0, u1), h);
+        let f = self.drive(w0, z0, (hx0, hx1), (u0, u1), h);
+        let (f0, f1) = f;
         if (f0 > 0.0 && f1 < 0.0) || (f0 < 0.0 && f1 > 0.0) {
             let tau = f0 / (f0 - f1);
             if tau > 0.05 && tau < 0.95 {
                 let hx_mid = hx0 + (hx1 - hx0) * tau;
                 let u_mid = u0 + (u1 - u0) * tau;
-                let (wm, zm) = self.stage_mono(w0, z0, (tau * hx0, tau * hx_mid), (u0, u_mid), tau * h);
+                let hx = (tau * hx0, tau * hx_mid);
+                let f = self.drive(w0, z0, hx, (u0, u_mid), tau * h);
+                let (wm, zm) = self.stage_mono(w0, z0, f, u_mid, tau * h);
                 let rest = 1.0 - tau;
-                return self.stage_mono(wm, zm, (rest * hx_mid, rest * hx1), (u_mid, u1), rest * h);
+                let (hx, u) = ((rest * hx_mid, rest * hx1), (u_mid, u1));
+                let f = self.drive(wm, zm, hx, u, rest * h);
+                return self.stage_mono(wm, zm, f, u1, rest * h);
             }
         }
-        self.stage_mono(w0, z0, (hx0, hx1), (u0, u1), h)
+        self.stage_mono(w0, z0, f, u1, h)
     }
 
     /// `h·ẇ` at both ends of a stage with `z`, `w` frozen at the start (eq. 5).
@@ -614,20 +631,21 @@ impl Spencer {
         (f0, f1)
     }
 
-    /// The exponentially fitted θ-step over one stage (module docs, item 2).
+    /// The exponentially fitted θ-step over one stage (module docs, item 2), from the stage's
+    /// [`drive`](Self::drive) `(f0, f1)` and the filtered command `u1` at its end.
     #[inline]
-    fn stage_mono(&self, w0: f32, z0: f32, hx: (f32, f32), u: (f32, f32), h: f32) -> (f32, f32) {
+    fn stage_mono(&self, w0: f32, z0: f32, (f0, f1): (f32, f32), u1: f32, h: f32) -> (f32, f32) {
         let k0 = self.p.k0;
-        let (f0, f1) = self.drive(w0, z0, hx, u, h);
-        let (al1, c01, c11) = self.coefficients(u.1);
+        let (al1, c01, c11) = self.coefficients(u1);
         let s1 = c01 + c11;
         // Branch from the trapezoidal prediction, then θ fitted to λ on that branch.
         let dir = if f0 + f1 < 0.0 { -1.0 } else { 1.0 };
-        let lam_h = h * (k0 + al1 * self.slope(dir * z0)) / s1;
+        let h_s1 = h / s1;
+        let lam_h = h_s1 * (k0 + al1 * self.slope(dir * z0));
         let theta = fitted_theta(lam_h);
         let r = (1.0 - theta) * f0 + theta * f1;
-        let a = 1.0 + theta * h * k0 / s1;
-        let b = theta * h * al1 / s1;
+        let a = 1.0 + theta * h_s1 * k0;
+        let b = theta * h_s1 * al1;
         let sgn = if r < 0.0 { -1.0 } else { 1.0 };
         let (d, zeta1) = self.solve(sgn * z0, a, b, sgn * r);
         (w0 + sgn * d, sgn * zeta1)
@@ -650,18 +668,18 @@ impl Spencer {
             } else if h < 0.0 {
                 lo = d;
             } else {
-                break;
+                return (d, zeta);
             }
-            let dh = a + b * self.slope(zeta);
-            let mut next = d - h / dh;
+            let g = self.slope(zeta);
+            let mut next = d - h / (a + b * g);
             if !(next >= lo && next <= hi) {
                 next = 0.5 * (lo + hi);
+            } else if abs(next - d) <= 2e-6 * d {
+                // Converged by a Newton step: ζ moves with D at slope g over a step this
+                // small (the second-order term is ~1e-12 of ζ), so no further flow is needed.
+                return (next, crate::math::clamp(zeta + g * (next - d), -self.zmax, self.zmax));
             }
-            let done = abs(next - d) <= 2e-6 * d;
             d = next;
-            if done {
-                break;
-            }
         }
         // ζ consistent with the returned D.
         (d, self.flow(zeta0, d))
@@ -731,7 +749,8 @@ impl Model for Spencer {
         let v1 = raw_command(k.u);
         // Stage count from the stiffness of the z–w loop at the new command (1 at 3 kHz
         // for the published set and any command below ~4.6 V).
-        let (al1, c01, c11) = self.coefficients(self.filter.step(s.u, s.v_prev, v1));
+        let u_end = self.filter.step(s.u, s.v_prev, v1);
+        let (al1, c01, c11) = self.coefficients(u_end);
         let lam_t = dt * (p.k0 + al1 * self.slope_max) / (c01 + c11);
         let m = stage_count(lam_t);
         let (m, filter) = match self.stage_filters.get(m - 1) {
@@ -749,8 +768,8 @@ impl Model for Spencer {
             let frac = j as f32 / m as f32;
             let hx1 = h * (x_rate0 + (x_rate1 - x_rate0) * frac);
             let v_next = s.v_prev + (v1 - s.v_prev) * frac;
-            // Command filter, eq. 7.
-            let u_next = filter.step(u, v, v_next);
+            // Command filter, eq. 7 (over the whole step it is already known).
+            let u_next = if m == 1 { u_end } else { filter.step(u, v, v_next) };
             (w, z) = self.stage(w, z, (hx0, hx1), (u, u_next), h);
             (u, v, hx0) = (u_next, v_next, hx1);
         }
