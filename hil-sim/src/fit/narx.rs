@@ -62,7 +62,8 @@ fn subsample(rows: &[usize]) -> Vec<usize> {
 
 /// Train model `id` (`narx` or `hammerstein_wiener`) on `rows` of `kin` → `y`.
 /// `iterations`: Levenberg–Marquardt iterations (Jacobians) on the first `window` samples,
-/// then a quarter as many on the whole training part. `None` for another model or when no
+/// then a few more on the first three windows (every Jacobian runs the network once per
+/// free weight over its stretch, so this bounds the cost on long recordings). `None` for another model or when no
 /// valid network was found.
 #[allow(clippy::too_many_arguments)]
 pub fn train(
@@ -177,7 +178,9 @@ pub fn train(
         return None;
     }
     let a = lm::minimize(&win, &start, iterations);
-    let full = Objective::new(sim.as_ref(), &sp, kin, y, &sub, ysd);
+    let long: Vec<usize> = rows.iter().copied().filter(|&i| i < 3 * window).collect();
+    let long = if long.len() < 200 { sub } else { subsample(&long) };
+    let full = Objective::new(sim.as_ref(), &sp, kin, y, &long, ysd);
     let b = lm::minimize(&full, &a.params, (iterations / 4).max(1));
     let params = if id == "hammerstein_wiener" { embed_hw(&b.params)? } else { b.params };
     Some(Trained { params, evaluations: a.evaluations + b.evaluations, cost: b.cost })

@@ -92,6 +92,17 @@ pub fn closed_form(id: &str, n_ops: usize, kin: &[Kin], y: &[f64], rows: &[usize
             // times M₀), so M₀ takes the sign of the offset.
             let big = lo.abs().max(hi.abs()) + 2.0 * span + 1.0;
             let hyster = n_ops - 1;
+            // p₀ ≥ ε keeps the analytical inverse (which needs p₀ > 0) available for
+            // feed-forward: the fit runs on y − ε·x with p₀ − ε ≥ 0.
+            let ys: Vec<f64> = rows.iter().filter_map(|&i| y.get(i).copied()).collect();
+            let y_spread =
+                ys.iter().fold(f64::NEG_INFINITY, |a, v| a.max(*v)) - ys.iter().fold(f64::INFINITY, |a, v| a.min(*v));
+            let eps = 1e-3 * y_spread.max(1e-12) / span;
+            let y_eps: Vec<f64> = y
+                .iter()
+                .zip(kin.iter().chain(std::iter::repeat(&Kin::default())))
+                .map(|(v, k)| v - eps * f64::from(k.x))
+                .collect();
             for spread in SPREADS {
                 let radii: Vec<f64> = (1..=hyster).map(|i| spread * 0.5 * span * i as f64 / hyster as f64).collect();
                 for m0 in [big, -big] {
@@ -100,11 +111,11 @@ pub fn closed_form(id: &str, n_ops: usize, kin: &[Kin], y: &[f64], rows: &[usize
                         cols.push(play_column(kin, *r as f32, m0 as f32));
                     }
                     cols.push(play_column(kin, (3.0 * big) as f32, m0 as f32));
-                    let (g, b) = nnls::normal_equations(&cols, y, rows);
+                    let (g, b) = nnls::normal_equations(&cols, &y_eps, rows);
                     let theta = nnls::solve(&g, &b, &vec![true; cols.len()])?;
-                    let c = cost(&cols, theta.as_slice(), y, rows);
+                    let c = cost(&cols, theta.as_slice(), &y_eps, rows);
                     // Flat order: p0, m0, r[N], p[N].
-                    let mut p = vec![theta[0], m0];
+                    let mut p = vec![theta[0] + eps, m0];
                     p.extend(radii.iter().copied());
                     p.push(3.0 * big);
                     p.extend(theta.iter().skip(1).copied());
@@ -144,8 +155,9 @@ pub fn closed_form(id: &str, n_ops: usize, kin: &[Kin], y: &[f64], rows: &[usize
 enum Linear {
     /// Preisach: offset `y₀` and scale `s` (flat 4, 5).
     Preisach,
-    /// GPI with polynomial envelopes: `p₀ ≥ ·`, `δ₁ ≥ 0` and an offset written as a common
-    /// shift of both envelopes' `b` and of `M₀` (the play operators commute with it).
+    /// GPI: `p₀`, `δ₁ ≥ 0` and an offset written as a common shift of both envelopes
+    /// (their additive coefficient: `b` of the polynomial, `c` of tanh) and of `M₀` (the
+    /// play operators commute with it).
     Gpi,
 }
 
@@ -189,7 +201,8 @@ impl<'a> Projected<'a> {
             Linear::Gpi => {
                 set(&mut q, 0, 0.0);
                 set(&mut q, 2, 1.0);
-                set(&mut q, 5, 0.0);
+                let at = gpi_shift_index(&q);
+                set(&mut q, at, 0.0);
             }
         }
         q
@@ -238,14 +251,26 @@ impl<'a> Projected<'a> {
                     return None;
                 }
                 let shift = off / (d1 * sum_w);
+                let at = gpi_shift_index(&q);
                 set(&mut full, 0, p0);
                 set(&mut full, 2, d1);
                 set(&mut full, 1, q.get(1)? + shift);
-                set(&mut full, 5, shift);
-                set(&mut full, 8, q.get(8)? + shift);
+                set(&mut full, at, shift);
+                set(&mut full, at + 3, q.get(at + 3)? + shift);
             }
         }
         Some(full)
+    }
+}
+
+/// Flat index of the right envelope's additive coefficient (the left one's is 3 further):
+/// `c_r` for tanh envelopes, `b_r` for the polynomial (Gaussian envelopes have none; their
+/// offset is left at `b_r`, which is not additive, so the closed form does not apply).
+fn gpi_shift_index(q: &[f64]) -> usize {
+    if q.get(12).copied() == Some(1.0) {
+        6
+    } else {
+        5
     }
 }
 
