@@ -465,7 +465,7 @@ fn identify(
             // Hammerstein–Wiener one 32.
             let lm_its = opts.lm_iterations.max(1);
             let (iterations, window) = if id == "narx" {
-                (lm_its + 4, opts.swarm_window.min(4000))
+                (lm_its + 4, opts.swarm_window.min(6000))
             } else {
                 (3 * lm_its, opts.swarm_window.min(6000))
             };

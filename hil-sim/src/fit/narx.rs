@@ -182,8 +182,12 @@ pub fn train(
     let long = if long.len() < 200 { sub } else { subsample(&long) };
     let full = Objective::new(sim.as_ref(), &sp, kin, y, &long, ysd);
     let b = lm::minimize(&full, &a.params, (iterations / 4).max(1));
-    let params = if id == "hammerstein_wiener" { embed_hw(&b.params)? } else { b.params };
-    Some(Trained { params, evaluations: a.evaluations + b.evaluations, cost: b.cost })
+    // The start (a linear FIR / identity network) is itself a valid model: keep it when the
+    // training did not beat it over the longer stretch.
+    let start_cost = full.cost(&start);
+    let (best, cost) = if b.cost <= start_cost { (b.params, b.cost) } else { (start, start_cost) };
+    let params = if id == "hammerstein_wiener" { embed_hw(&best)? } else { best };
+    Some(Trained { params, evaluations: a.evaluations + b.evaluations + 1, cost })
 }
 
 /// Write a trained `HammersteinWiener<3, 3>` vector into the registered size, the extra

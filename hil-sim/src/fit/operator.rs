@@ -344,3 +344,55 @@ pub fn abw_crossing(flat: &[f64], dt: f32, kin: &[Kin], rows: &[usize]) -> Optio
     let rate = rates.iter().sum::<f64>() / rates.len().max(1) as f64;
     Some(m.crossing_risk(lo as f32, hi as f32, rate as f32))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::simulate::simulator;
+
+    fn triangle(n: usize) -> Vec<Kin> {
+        (0..n)
+            .map(|i| {
+                let ph = (i % 2000) as f32 / 2000.0;
+                let x = if ph < 0.5 { 4.0 * ph } else { 4.0 * (1.0 - ph) } * (1.0 + 0.3 * (i / 2000) as f32 % 2.0);
+                Kin::new(x, 0.0, 0.0, 0.0)
+            })
+            .collect()
+    }
+
+    /// The closed form reproduces a Maxwell-slip and a PI loop that its radii can represent.
+    #[test]
+    fn closed_form_reproduces_operator_loops() {
+        let kin = triangle(12_000);
+        let rows: Vec<usize> = (0..kin.len()).collect();
+        for id in ["maxwell_slip", "prandtl_ishlinskii"] {
+            let sim = simulator(id, 1e-3).unwrap();
+            let truth: Vec<f64> = if id == "maxwell_slip" {
+                let mut p = vec![0.5];
+                p.extend([2.0, 0.0, 1.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 0.0]);
+                p.extend(
+                    [2.0, 0.0, 1.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 0.0]
+                        .iter()
+                        .enumerate()
+                        .map(|(i, k)| k * 0.1 * (i + 1) as f64),
+                );
+                p.push(0.7);
+                p
+            } else {
+                let mut p = vec![1.5, 0.0];
+                p.extend((0..10).map(|i| 0.1 * i as f64));
+                p.extend([0.0, 2.0, 0.0, 1.0, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0]);
+                p
+            };
+            let mut y = vec![0.0; kin.len()];
+            assert!(sim.run(&truth, &kin, &mut y), "{id}");
+            let (p, cost) = closed_form(id, 10, &kin, &y, &rows).unwrap();
+            let mut out = vec![0.0; kin.len()];
+            assert!(sim.run(&p, &kin, &mut out), "{id}: {p:?}");
+            let var = y.iter().map(|v| v * v).sum::<f64>() / y.len() as f64;
+            let mse = y.iter().zip(&out).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / y.len() as f64;
+            assert!(mse < 1e-3 * var && cost < 1e-3 * var, "{id}: mse {mse}, cost {cost}, var {var}");
+        }
+        assert!(closed_form("bouc_wen", 10, &kin, &[0.0; 10], &rows).is_none());
+    }
+}
