@@ -58,11 +58,14 @@ impl Budget {
 /// The budgets (issue "Firmware for the STM32 clutch driver board"): close to what
 /// hand-minimal kernels measured on this machine; `control_step` at 20 kHz stays under 5 %
 /// of the 170 MHz core. Steps not listed are measured and reported, without a target.
-pub const BUDGETS: [Budget; 5] = [
+pub const BUDGETS: [Budget; 6] = [
     Budget::met("algebraic", 30, 16),
     Budget::met("bouc_wen", 45, 16),
     Budget::met("tanh", 80, 64),
     Budget::met("lugre", 50, 24),
+    // The board's NARX (8 sigmoid units, 86 values; issue 7): 771 instructions / 160 B
+    // measured on 2026-11-22 (seed 000's 71-unit net: 6031 / 136 B).
+    Budget::met("narx", 800, 160),
     // Target not met yet (1010 instructions / 208 B measured on 2026-11-22): the supervisor
     // and the guards need a redesign to get there. The ceiling guards against regressions.
     Budget {

@@ -101,6 +101,38 @@ pub fn fit_plots(
     Ok(())
 }
 
+/// One loop plot per model over the whole held-out part (`<stem>_<model>_loop.svg`,
+/// at most 4000 points each): the shapes side by side, e.g. an asymmetric loop that the
+/// symmetric models (classical PI, Bouc–Wen) cannot follow. Against the input as recorded.
+pub fn loop_plots(
+    report: &mut Report,
+    dir: &Path,
+    stem: &str,
+    data: &Dataset,
+    results: &[FitResult],
+    labels: &Labels,
+) -> Result<(), PlotError> {
+    let (a, b) = (data.train_end.min(data.len()), data.len());
+    let every = (b - a).div_ceil(4000).max(1);
+    let pick = |v: &[f64]| -> Vec<f64> { v.get(a..b).unwrap_or(&[]).iter().step_by(every).copied().collect() };
+    let x = pick(&data.input);
+    let y = pick(&data.output);
+    for r in results {
+        let name = format!("{stem}_{}_loop.svg", r.model);
+        plot::hysteresis_loop(
+            dir.join(&name),
+            &format!("{}: held-out loop (GOF {:.3}, R² {:.4})", r.model, r.heldout.gof, r.heldout.r2),
+            &labels.input,
+            &labels.output,
+            &x,
+            &y,
+            &pick(&r.output),
+        )?;
+        report.image(&name, &format!("{}: held-out output vs input, measured (grey) and model", r.model));
+    }
+    Ok(())
+}
+
 /// Bar chart of held-out R-RMSE (%) per model.
 pub fn error_bars(report: &mut Report, dir: &Path, stem: &str, results: &[FitResult]) -> Result<(), PlotError> {
     let cats: Vec<String> = results.iter().map(|r| r.model.clone()).collect();

@@ -127,6 +127,7 @@ pub const BUILTIN: &[&str] = &[
     "multisine",
     "sweep",
     "triangle",
+    "triangle_asym",
     "noise",
     "cold_start",
     "heating",
@@ -210,6 +211,29 @@ impl Scenario {
                 reference: current(Signal::Triangle { f: 0.1 }),
                 ..base
             },
+            "triangle_asym" => {
+                // Seed 004's loop shape (Fig. 3): wide at the bottom, pointed at the top. A
+                // soft, wide magnetic hysteresis (coercive current ≈ 0.35 A) feeds a yoke and
+                // a fluid that saturate early, so the loop closes towards full current; at a
+                // slow, constant slip without warming, the loop is all there is.
+                let mut c = ClutchParams::default();
+                c.magnetic.r_max = 1.2;
+                c.magnetic.r_w = 0.6;
+                c.magnetic.n_play = 16;
+                c.magnetic.i_sat = 1.6;
+                c.fluid.b_tau = 0.35;
+                c.fluid.thermal_effects = false;
+                c.motor.speed = vec![[0.0, 5.0]];
+                c.motor.ripple = 0.0;
+                Self {
+                    description: "seed 004-like asymmetric loop: triangle 0.1 Hz, 0-3 A, saturating clutch, 30 s"
+                        .into(),
+                    duration_s: 30.0,
+                    reference: current(Signal::Triangle { f: 0.1 }),
+                    clutch: c,
+                    ..base
+                }
+            }
             "noise" => Self {
                 description: "band-limited noise 0.1-10 Hz, 0-3 A, 40 s".into(),
                 duration_s: 40.0,
@@ -299,6 +323,52 @@ impl Scenario {
             return bad("clutch.thermal: capacity and r_th must be > 0");
         }
         Ok(s)
+    }
+}
+
+/// A simulated recording of a current-driven scenario, as `hil-sim simulate` writes it.
+pub struct Recorded {
+    /// CSV text: `t,b,torque,i,i_ref,duty,speed,temperature,torque_true`.
+    pub csv: String,
+    pub rows: usize,
+    /// The whole run at the control rate (from the start of calibration).
+    pub run: crate::closed_loop::Run,
+    /// First sample of `run` after calibration.
+    pub first: usize,
+}
+
+/// Column names of [`Recorded::csv`].
+pub const RECORD_COLUMNS: [&str; 9] = ["t", "b", "torque", "i", "i_ref", "duty", "speed", "temperature", "torque_true"];
+
+impl Scenario {
+    /// Run this scenario (a current reference) against the simulated clutch and record it at
+    /// `record_hz`, time from the end of calibration.
+    pub fn record(&self) -> Result<Recorded, crate::closed_loop::LoopError> {
+        use crate::closed_loop::{current_driver, run, T_START};
+        let (step, cfg) = current_driver(&self.clutch, self.control_hz)?;
+        let dur = self.duration_s;
+        let reference = |t: f64| self.reference.at(t, dur);
+        let r = run(&self.clutch, &step, cfg, &reference, T_START + dur, self.seed, None);
+        let every = (self.control_hz / self.record_hz).round().max(1.0) as usize;
+        let k0 = r.after(T_START);
+        let mut csv = RECORD_COLUMNS.join(",") + "\n";
+        let mut rows = 0usize;
+        for k in (k0..r.t.len()).step_by(every) {
+            csv += &format!(
+                "{:.5},{:.6},{:.5},{:.5},{:.5},{:.5},{:.3},{:.3},{:.5}\n",
+                r.t[k] - T_START,
+                r.b[k],
+                r.load_cell[k],
+                r.current[k],
+                r.i_ref[k],
+                r.duty[k],
+                r.speed[k],
+                r.temperature[k],
+                r.torque_true[k]
+            );
+            rows += 1;
+        }
+        Ok(Recorded { csv, rows, run: r, first: k0 })
     }
 }
 

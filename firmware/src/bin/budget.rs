@@ -182,6 +182,7 @@ mod bench {
         p[f + 5 + 3 * 13 + 3] = 10.0;
         model::<hammerstein_wiener::Registered>(&p, sw(1.5, 0.0));
 
+        // The board's NARX (8 units, 86 values; `BUDGETS` row `narx`).
         const NX: usize = narx::Registered::N_PARAMS;
         let mut p = [0.0f32; NX];
         pattern(&mut p, 1.0);

@@ -114,6 +114,11 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let results = fit_all(&data, &ids, &opts)?;
     let total = t0.elapsed().as_secs_f64();
+    for r in &results {
+        for w in &r.warnings {
+            eprintln!("warning: {}: {w}", r.model);
+        }
+    }
     if let Some(dir) = &a.save {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         for r in &results {
@@ -215,7 +220,7 @@ pub fn write_report(
     input: &str,
     output: &str,
 ) -> anyhow::Result<PathBuf> {
-    use hil_sim::fit_report::{error_bars, fit_plots, results_table, Labels};
+    use hil_sim::fit_report::{error_bars, fit_plots, loop_plots, results_table, Labels};
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut rep = hil_sim::report::Report::new(title);
     rep.paragraph(&format!(
@@ -234,5 +239,12 @@ pub fn write_report(
         rep.heading(&format!("Best held-out model: {}", best.model));
         fit_plots(&mut rep, dir, &stem(&best.model), data, best, &labels)?;
     }
+    for r in results.iter().filter(|r| !r.warnings.is_empty()) {
+        for w in &r.warnings {
+            rep.paragraph(&format!("**Warning ({}):** {w}", r.model));
+        }
+    }
+    rep.heading("Hysteresis loops of every model (held-out part)");
+    loop_plots(&mut rep, dir, "heldout", data, results, &labels)?;
     Ok(rep.write(dir)?)
 }

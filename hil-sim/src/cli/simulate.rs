@@ -2,7 +2,6 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use hil_sim::closed_loop::{current_driver, run, T_START};
 use hil_sim::scenario::{Quantity, Scenario, BUILTIN};
 use serde_json::json;
 
@@ -27,31 +26,10 @@ pub fn run_cmd(a: SimulateArgs) -> anyhow::Result<()> {
             BUILTIN.join(", ")
         );
     }
-    let (step, cfg) = current_driver(&sc.clutch, sc.control_hz)?;
     let pb = super::progress(1, &sc.name);
-    let dur = sc.duration_s;
-    let reference = |t: f64| sc.reference.at(t, dur);
-    let r = run(&sc.clutch, &step, cfg, &reference, T_START + dur, sc.seed, None);
+    let rec = sc.record()?;
     pb.finish_and_clear();
-    let every = (sc.control_hz / sc.record_hz).round().max(1.0) as usize;
-    let k0 = r.after(T_START);
-    let mut csv = String::from("t,b,torque,i,i_ref,duty,speed,temperature,torque_true\n");
-    let mut rows = 0usize;
-    for k in (k0..r.t.len()).step_by(every) {
-        csv += &format!(
-            "{:.5},{:.6},{:.5},{:.5},{:.5},{:.5},{:.3},{:.3},{:.5}\n",
-            r.t[k] - T_START,
-            r.b[k],
-            r.load_cell[k],
-            r.current[k],
-            r.i_ref[k],
-            r.duty[k],
-            r.speed[k],
-            r.temperature[k],
-            r.torque_true[k]
-        );
-        rows += 1;
-    }
+    let (csv, rows, r, k0) = (rec.csv, rec.rows, rec.run, rec.first);
     if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }

@@ -17,7 +17,10 @@
 pub mod global;
 pub mod linear;
 pub mod lm;
+pub mod narx;
+pub mod nnls;
 pub mod objective;
+pub mod operator;
 pub mod simulate;
 pub mod spec;
 
@@ -232,6 +235,10 @@ pub struct FitResult {
     pub state_bytes: usize,
     /// Samples whose output the core held (non-finite or overflow) in the replay.
     pub held: usize,
+    /// What the fit noticed about the fitted set (e.g. a non-physical crossing loop of the
+    /// asymmetric Bouc–Wen model, seed 004 on eq. 30).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// Flat parameter vector (registry order).
     #[serde(skip)]
     pub flat: Vec<f64>,
@@ -263,7 +270,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     let sim = simulate::simulator(id, dt).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
     let rows = data.train_rows();
     let fit_at = |kin: &[model_core::Kin], sp: &ModelSpec| {
-        identify(id, sp, sim.as_ref(), kin, &data.output, &rows, scales.y, opts)
+        identify_variants(id, sp, sim.as_ref(), kin, &data.output, &rows, &scales, opts)
     };
     let n_model = sim.n_params();
     let ((mut params, evaluations), (delay, delay_u)) = match (opts.delay, sp.strategy) {
@@ -274,7 +281,9 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
             crate::alignment::shift_kin(&kin, d.0, d.1, &mut shifted);
             (fit_at(&shifted, &sp)?, d)
         }
-        (DelayChoice::Auto, Strategy::Linear) => {
+        // A network has past inputs for the lags it needs.
+        (DelayChoice::Auto, Strategy::Network) => (fit_at(&kin, &sp)?, (0.0, 0.0)),
+        (DelayChoice::Auto, Strategy::Linear | Strategy::Operator) => {
             let found = scan_delay(&kin, |k| {
                 let r = fit_at(k, &sp).ok()?;
                 let cost = Objective::new(sim.as_ref(), &sp, k, &data.output, &rows, scales.y).cost(&r.0);
@@ -292,6 +301,18 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     };
     params.truncate(n_model);
     let fit_seconds = started.elapsed().as_secs_f64();
+    let mut warnings = Vec::new();
+    if id == "bouc_wen_asym" {
+        let mut shifted = Vec::new();
+        crate::alignment::shift_kin(&kin, delay, delay_u, &mut shifted);
+        if operator::abw_crossing(&params, dt, &shifted, &rows) == Some(true) {
+            let eq = if params.get(11).copied() == Some(1.0) { "eq. 30" } else { "eq. 31" };
+            warnings.push(format!(
+                "bouc_wen_asym ({eq}): the fitted loop crosses itself over the training range at the data's mean \
+                 rate, a non-physical artefact (seed 004 §6.2); do not use this set for control"
+            ));
+        }
+    }
 
     // Score with the Estimator path, the firmware's code, over the whole recording.
     let p32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
@@ -331,9 +352,10 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         evaluations,
         replay_ns_per_sample: replay_ns,
         n_params: info.n_params,
-        free_params: sp.free().len(),
+        free_params: sp.free().len() + operator::projected_count(id),
         state_bytes: info.state_bytes,
         held: rep.held,
+        warnings,
         flat: params,
         rate_choice: sp.rate,
         output,
@@ -345,6 +367,45 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
 fn uses_command(id: &str, scales: &Scales) -> bool {
     let free = |s: &Scales| spec::spec(id, s, None).map_or(0, |sp| sp.free().len());
     free(&Scales { u: None, ..*scales }) < free(scales)
+}
+
+/// [`identify`] for every variant of the search ([`spec::variant`]); the lowest training
+/// cost wins.
+#[allow(clippy::too_many_arguments)]
+fn identify_variants(
+    id: &str,
+    sp: &ModelSpec,
+    sim: &dyn simulate::Simulator,
+    kin: &[model_core::Kin],
+    y: &[f64],
+    rows: &[usize],
+    scales: &Scales,
+    opts: &FitOptions,
+) -> Result<(Vec<f64>, usize), FitError> {
+    let mut best: Option<(Vec<f64>, usize, f64)> = None;
+    let mut evals = 0;
+    let mut first_err = None;
+    let mut k = 0;
+    let mut current = Some(sp.clone());
+    while let Some(v) = current {
+        match identify(id, &v, sim, kin, y, rows, scales.y, opts) {
+            Ok((p, e)) => {
+                evals += e;
+                let cost = Objective::new(sim, &v, kin, y, rows, scales.y).cost(&p);
+                if best.as_ref().is_none_or(|b| cost < b.2) {
+                    best = Some((p, e, cost));
+                }
+            }
+            Err(e) => first_err = first_err.or(Some(e)),
+        }
+        k += 1;
+        current = spec::variant(sp, k, scales);
+    }
+    match (best, first_err) {
+        (Some((p, _, _)), _) => Ok((p, evals)),
+        (None, Some(e)) => Err(e),
+        (None, None) => Err(FitError::NoValidSet { model: id.to_owned() }),
+    }
 }
 
 /// The search itself: returns the parameters and the number of model evaluations.
@@ -375,6 +436,47 @@ fn identify(
         Strategy::Local => {
             let r = lm::minimize(&full, &sp.start(), opts.lm_iterations);
             valid_or_err(id, sim, r.params, r.evaluations)
+        }
+        Strategy::Operator => {
+            let n_ops = (sim.n_params().saturating_sub(2)) / 2;
+            let (mut p, _) = operator::closed_form(id, n_ops, kin, y, rows)
+                .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
+            // Delay entries, if the spec carries them, stay at their (zero) start.
+            p.extend(sp.start().get(sim.n_params()..).unwrap_or(&[]).iter().copied());
+            valid_or_err(id, sim, p, 1)
+        }
+        Strategy::Projected => {
+            let proj = operator::Projected::new(sim, y, rows).ok_or_else(|| FitError::NotFittable(id.to_owned()))?;
+            // The grid / radii span the training range.
+            let end = rows.last().map_or(0, |r| r + 1).min(kin.len());
+            let (lo, hi) = operator::x_range(kin, end);
+            let pad = 1e-3 * (hi - lo).max(1e-12);
+            let mut shape = sp.clone();
+            shape.strategy = Strategy::Global;
+            for (name, v) in [("x_min", lo - pad), ("x_max", hi + pad)] {
+                if let Some(p) = shape.params.iter_mut().find(|p| p.name == name) {
+                    (p.lo, p.hi, p.start) = (v, v, v);
+                }
+            }
+            let (p, evals) = identify(id, &shape, &proj, kin, y, rows, y_scale, opts)?;
+            let full = proj.complete(&p, kin).ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
+            valid_or_err(id, sim, full, evals)
+        }
+        Strategy::Network => {
+            // Both networks are discrete-time (one step per sample): the step size only has
+            // to be valid.
+            // Budgets that keep each network to a few seconds on the Dyke files: the NARX net
+            // has 79 free weights (one network run per weight per Jacobian), the small
+            // Hammerstein–Wiener one 32.
+            let lm_its = opts.lm_iterations.max(1);
+            let (iterations, window) = if id == "narx" {
+                (lm_its + 4, opts.swarm_window.min(6000))
+            } else {
+                (3 * lm_its, opts.swarm_window.min(6000))
+            };
+            let t = narx::train(id, kin, y, rows, 1e-3, sp.rate, iterations, window, opts.swarm.seed)
+                .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
+            valid_or_err(id, sim, t.params, t.evaluations)
         }
         Strategy::Global => {
             let window_rows: Vec<usize> = rows.iter().copied().filter(|&i| i < opts.swarm_window).collect();

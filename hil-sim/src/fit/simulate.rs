@@ -69,6 +69,12 @@ pub fn simulator(id: &str, dt: f32) -> Option<Box<dyn Simulator>> {
     visit(id, Make(dt))
 }
 
+/// The simulator of a model type that is not in the registry (e.g. a smaller size of a
+/// const-generic model, trained before it is written into the registered size).
+pub fn simulator_of<M: Model>(dt: f32) -> Box<dyn Simulator> {
+    Box::new(Sim::<M> { dt, _m: PhantomData })
+}
+
 /// The kinematics the core sees for each sample, from the rate estimator `rate` exactly as
 /// [`model_core::Estimator::step`] computes them (a measured rate in the sample wins).
 /// `None` if the estimate overflows (the inputs are checked finite before).

@@ -23,7 +23,8 @@
 //! # Parameters (flat vector order)
 //! `u_mean, u_scale, y_mean, y_scale, lin[7], hid_w[7·H] (unit-major: the 7 weights of unit
 //! 0, then unit 1, …), hid_b[H], out_a[H], offset, y_min, y_max` — `9·H + 14` values.
-//! [`Registered`] has `H = 71`: 653 values (seed 000's NARX: 656 units). Weights `|·| ≤ 1e6`,
+//! [`Registered`] has `H = 8`: 86 values, the board's size; [`Seed000`] has `H = 71`: 653
+//! values (seed 000's NARX: 656 units). Weights `|·| ≤ 1e6`,
 //! scales in `[1e−12, 1e12]`, `y_min < y_max`.
 //!
 //! State: the five past inputs (raw) and the last output. It starts at the first sample
@@ -72,8 +73,13 @@ impl Finite for State {
     }
 }
 
-/// 71 hidden units: 653 parameters (seed 000: 656 units).
-pub type Registered = Narx<71>;
+/// The board's size: 8 hidden units, 86 parameters (344 B of weights), small enough for the
+/// configuration page and a 20 kHz control step. `hil-sim fit` trains this size
+/// (issue 7: seed 000's network was rejected for the controller at 656 units).
+pub type Registered = Narx<8>;
+
+/// Seed 000's size: 71 hidden units, 653 parameters (seed 000: 656 units).
+pub type Seed000 = Narx<71>;
 
 impl<const H: usize> Narx<H> {
     const N_HID_W: BlockName = BlockName::new("hid_w", 7 * H);
@@ -334,13 +340,18 @@ mod tests {
 
     #[test]
     fn names_and_round_trip() {
-        assert_eq!(Registered::N_PARAMS, 653);
-        let total: usize = Registered::PARAM_NAMES
-            .iter()
-            .map(|n| n.split_once('[').map_or(1, |(_, r)| r.trim_end_matches(']').parse::<usize>().unwrap()))
-            .sum();
-        assert_eq!(total, Registered::N_PARAMS);
-        assert!(Registered::PARAM_NAMES.contains(&"hid_w[497]"));
+        assert_eq!(Registered::N_PARAMS, 86);
+        assert_eq!(Seed000::N_PARAMS, 653);
+        let total = |names: &[&str]| -> usize {
+            names
+                .iter()
+                .map(|n| n.split_once('[').map_or(1, |(_, r)| r.trim_end_matches(']').parse::<usize>().unwrap()))
+                .sum()
+        };
+        assert_eq!(total(Registered::PARAM_NAMES), Registered::N_PARAMS);
+        assert_eq!(total(Seed000::PARAM_NAMES), Seed000::N_PARAMS);
+        assert!(Seed000::PARAM_NAMES.contains(&"hid_w[497]"));
+        assert!(Registered::PARAM_NAMES.contains(&"hid_w[56]"));
         let m = small();
         let mut out = [0.0f32; 32];
         assert_eq!(m.write_params(&mut out), 32);

@@ -1,0 +1,233 @@
+//! Training of the data-driven models of seed 000 (NARX, eq. 18–19; Hammerstein–Wiener,
+//! eq. 15–17) on the host, in simulation mode: the network runs on its own past output,
+//! as on the board, and Levenberg–Marquardt ([`super::lm`], the `levenberg-marquardt`
+//! crate) minimises that simulation error through the f32 core.
+//!
+//! - NARX: the registered size ([`model_core::models::narx::Registered`], 8 sigmoid units,
+//!   86 values) is trained directly. Start: the linear part from a closed-form FIR fit
+//!   (no output feedback, so the start is stable), the hidden units small and random (fixed
+//!   seed).
+//! - Hammerstein–Wiener: a small network (3 + 3 sigmoid units, 32 values) is trained and
+//!   written into the registered size with the remaining units at zero weight (they add
+//!   exactly nothing), so the fit costs seconds, not the minutes 95 free weights would.
+//!   Start: both static nets the identity plus small random units, the linear block a pure
+//!   one-sample delay, and the output net's linear part the least-squares line.
+
+use model_core::models::hammerstein_wiener::HammersteinWiener;
+use model_core::Kin;
+use rand::rngs::StdRng;
+use rand::{Rng, SeedableRng};
+
+use super::lm;
+use super::objective::Objective;
+use super::simulate::simulator_of;
+use super::spec::{ModelSpec, ParamSpec, Spacing, Strategy};
+use crate::dispatch::RateChoice;
+
+/// Hidden units of the Hammerstein–Wiener networks that are trained (input, output side).
+pub const HW_TRAINED: (usize, usize) = (3, 3);
+type SmallHw = HammersteinWiener<3, 3>;
+
+/// Largest number of training rows the residual vector (and the Jacobian) has: longer
+/// training parts are subsampled evenly (the network still runs over every sample).
+const MAX_ROWS: usize = 6000;
+
+/// How a training run went.
+#[derive(Clone, Debug)]
+pub struct Trained {
+    /// Flat vector of the registered model.
+    pub params: Vec<f64>,
+    pub evaluations: usize,
+    /// Mean squared scaled residual on the (subsampled) training rows.
+    pub cost: f64,
+}
+
+fn ps(name: &'static str, lo: f64, hi: f64, start: f64) -> ParamSpec {
+    ParamSpec { name, lo, hi, start: start.clamp(lo, hi), spacing: Spacing::Linear, fixed: false }
+}
+fn fixed(name: &'static str, v: f64) -> ParamSpec {
+    ParamSpec { name, lo: v, hi: v, start: v, spacing: Spacing::Linear, fixed: true }
+}
+
+fn mean_std(v: &[f64]) -> (f64, f64) {
+    let n = v.len().max(1) as f64;
+    let m = v.iter().sum::<f64>() / n;
+    (m, (v.iter().map(|a| (a - m) * (a - m)).sum::<f64>() / n).sqrt().max(1e-12))
+}
+
+fn subsample(rows: &[usize]) -> Vec<usize> {
+    let step = rows.len().div_ceil(MAX_ROWS).max(1);
+    rows.iter().step_by(step).copied().collect()
+}
+
+/// Train model `id` (`narx` or `hammerstein_wiener`) on `rows` of `kin` → `y`.
+/// `iterations`: Levenberg–Marquardt iterations (Jacobians) on the first `window` samples,
+/// then a few more on the first three windows (every Jacobian runs the network once per
+/// free weight over its stretch, so this bounds the cost on long recordings). `None` for another model or when no
+/// valid network was found.
+#[allow(clippy::too_many_arguments)]
+pub fn train(
+    id: &str,
+    kin: &[Kin],
+    y: &[f64],
+    rows: &[usize],
+    dt: f32,
+    rate: RateChoice,
+    iterations: usize,
+    window: usize,
+    seed: u64,
+) -> Option<Trained> {
+    let xs: Vec<f64> = rows.iter().filter_map(|&i| kin.get(i)).map(|k| f64::from(k.x)).collect();
+    let ys: Vec<f64> = rows.iter().filter_map(|&i| y.get(i).copied()).collect();
+    let (xm, xsd) = mean_std(&xs);
+    let (ym, ysd) = mean_std(&ys);
+    let (ylo, yhi) = ys.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+    let (xlo, xhi) = xs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+    let mut rng = StdRng::seed_from_u64(seed);
+    let sub = subsample(rows);
+    let (spec, sim) = match id {
+        "narx" => {
+            use model_core::models::narx::Registered as Nx;
+            use model_core::Model;
+            let h = (Nx::N_PARAMS - 14) / 9;
+            // FIR start: ŷ(t) = Σ bₖ·û(t−k) + c, closed form on the training rows.
+            let un = |i: usize| (f64::from(kin.get(i).map_or(0.0, |k| k.x)) - xm) / xsd;
+            let fir_rows: Vec<usize> = rows.iter().copied().filter(|&i| i >= 5).collect();
+            let mut cols: Vec<Vec<f64>> =
+                (0..6).map(|lag| (0..kin.len()).map(|i| un(i.saturating_sub(lag))).collect()).collect();
+            cols.push(vec![1.0; kin.len()]);
+            let yn: Vec<f64> = y.iter().map(|v| (v - ym) / ysd).collect();
+            let (g, b) = super::nnls::normal_equations(&cols, &yn, &fir_rows);
+            let fir = super::nnls::solve(&g, &b, &[false; 7])?;
+            let mut p = vec![
+                fixed("u_mean", xm),
+                fixed("u_scale", xsd),
+                fixed("y_mean", ym),
+                fixed("y_scale", ysd),
+                ps("lin", -5.0, 5.0, 0.0),
+            ];
+            for k in 0..6 {
+                p.push(ps("lin", -20.0, 20.0, fir[k]));
+            }
+            for _ in 0..7 * h {
+                p.push(ps("hid_w", -10.0, 10.0, rng.random_range(-0.7..0.7)));
+            }
+            for _ in 0..h {
+                p.push(ps("hid_b", -10.0, 10.0, rng.random_range(-1.0..1.0)));
+            }
+            for _ in 0..h {
+                p.push(ps("out_a", -10.0, 10.0, rng.random_range(-0.1..0.1)));
+            }
+            p.push(ps("offset", -10.0, 10.0, fir[6]));
+            let margin = 0.25 * (yhi - ylo).max(1e-9);
+            p.push(fixed("y_min", ylo - margin));
+            p.push(fixed("y_max", yhi + margin));
+            (p, simulator_of::<Nx>(dt))
+        }
+        "hammerstein_wiener" => {
+            let (nh, nw) = HW_TRAINED;
+            // Output net's line: y ≈ w_lin·x + w_d.
+            let slope = {
+                let cov: f64 =
+                    rows.iter().filter_map(|&i| Some((f64::from(kin.get(i)?.x) - xm) * (y.get(i)? - ym))).sum::<f64>()
+                        / rows.len().max(1) as f64;
+                cov / (xsd * xsd)
+            };
+            let yb = ym.abs() + 10.0 * ysd;
+            let xb = 20.0 * (1.0 + xm.abs() / xsd);
+            let mut p = Vec::new();
+            let mut net = |p: &mut Vec<ParamSpec>, n: usize, a_scale: f64, names: [&'static str; 3]| {
+                for _ in 0..n {
+                    p.push(ps(names[0], -5.0 * a_scale, 5.0 * a_scale, a_scale * rng.random_range(-0.1..0.1)));
+                }
+                let ws: Vec<f64> = (0..n)
+                    .map(|_| rng.random_range(0.5..2.0) / xsd * if rng.random::<bool>() { 1.0 } else { -1.0 })
+                    .collect();
+                for w in &ws {
+                    p.push(ps(names[1], -20.0 / xsd, 20.0 / xsd, *w));
+                }
+                for w in &ws {
+                    p.push(ps(names[2], -xb, xb, -w * xm + rng.random_range(-1.0..1.0)));
+                }
+            };
+            net(&mut p, nh, xsd, ["h_a", "h_w", "h_b"]);
+            p.push(ps("h_lin", -5.0, 5.0, 1.0));
+            p.push(ps("h_d", -5.0 * xsd - xm.abs(), 5.0 * xsd + xm.abs(), 0.0));
+            p.push(ps("lin_b", -3.0, 3.0, 1.0));
+            p.push(ps("lin_b", -3.0, 3.0, 0.0));
+            p.push(ps("lin_b", -3.0, 3.0, 0.0));
+            for _ in 0..5 {
+                p.push(ps("lin_f", -2.0, 2.0, 0.0));
+            }
+            net(&mut p, nw, ysd, ["w_a", "w_w", "w_b"]);
+            p.push(ps("w_lin", -20.0 * ysd / xsd, 20.0 * ysd / xsd, slope));
+            p.push(ps("w_d", -yb, yb, ym - slope * xm));
+            let span = (xhi - xlo).max(1e-9);
+            p.push(fixed("v_min", xlo - 2.0 * span));
+            p.push(fixed("v_max", xhi + 2.0 * span));
+            (p, simulator_of::<SmallHw>(dt))
+        }
+        _ => return None,
+    };
+    let sp = ModelSpec { id: super::spec::static_id(id)?, params: spec, strategy: Strategy::Network, rate };
+    let start = sp.start();
+    let win_rows: Vec<usize> = rows.iter().copied().filter(|&i| i < window).collect();
+    let win_rows = if win_rows.len() < 200 { sub.clone() } else { subsample(&win_rows) };
+    let win = Objective::new(sim.as_ref(), &sp, kin, y, &win_rows, ysd);
+    if !win.cost(&start).is_finite() {
+        return None;
+    }
+    let a = lm::minimize(&win, &start, iterations);
+    let long: Vec<usize> = rows.iter().copied().filter(|&i| i < 3 * window).collect();
+    let long = if long.len() < 200 { sub } else { subsample(&long) };
+    let full = Objective::new(sim.as_ref(), &sp, kin, y, &long, ysd);
+    let b = lm::minimize(&full, &a.params, (iterations / 4).max(1));
+    // The start (a linear FIR / identity network) is itself a valid model: keep it when the
+    // training did not beat it over the longer stretch.
+    let start_cost = full.cost(&start);
+    let (best, cost) = if b.cost <= start_cost { (b.params, b.cost) } else { (start, start_cost) };
+    let params = if id == "hammerstein_wiener" { embed_hw(&best)? } else { best };
+    Some(Trained { params, evaluations: a.evaluations + b.evaluations + 1, cost })
+}
+
+/// Write a trained `HammersteinWiener<3, 3>` vector into the registered size, the extra
+/// units with zero output weight.
+fn embed_hw(small: &[f64]) -> Option<Vec<f64>> {
+    use model_core::models::hammerstein_wiener::Registered as Hw;
+    use model_core::Model;
+    let (nh, nw) = HW_TRAINED;
+    let big_h = (Hw::N_PARAMS - 14 - 3 * registered_nw()) / 3;
+    let big_w = registered_nw();
+    let mut out = Vec::with_capacity(Hw::N_PARAMS);
+    let mut it = small.iter().copied();
+    let block = |out: &mut Vec<f64>, n: usize, big: usize, it: &mut dyn Iterator<Item = f64>| {
+        for _ in 0..n {
+            out.push(it.next().unwrap_or(0.0));
+        }
+        out.extend(std::iter::repeat_n(0.0, big - n));
+    };
+    for _ in 0..3 {
+        block(&mut out, nh, big_h, &mut it);
+    }
+    // h_lin, h_d, lin_b[3], lin_f[5]
+    for _ in 0..10 {
+        out.push(it.next()?);
+    }
+    for _ in 0..3 {
+        block(&mut out, nw, big_w, &mut it);
+    }
+    for _ in 0..4 {
+        out.push(it.next()?);
+    }
+    (out.len() == Hw::N_PARAMS).then_some(out)
+}
+
+/// Output-side units of the registered Hammerstein–Wiener model.
+fn registered_nw() -> usize {
+    use model_core::models::hammerstein_wiener::Registered as Hw;
+    use model_core::Model;
+    Hw::PARAM_NAMES
+        .get(7)
+        .and_then(|n| n.split_once('[').and_then(|(_, r)| r.trim_end_matches(']').parse().ok()))
+        .unwrap_or(0)
+}

@@ -1,0 +1,112 @@
+//! Issue 7 acceptance on simulated clutch recordings (`hil-sim simulate` scenarios, run
+//! through the library): every model that maps the field level to torque is identified and
+//! replayed through the no_std core with a held-out R² ≥ 0.8 on the multi-sine; on seed
+//! 004's asymmetric triangle loop the asymmetric operator models (GPI, Preisach) reach a
+//! GOF ≥ 0.95 where the symmetric ones (classical PI, classical Bouc–Wen) do not; and the
+//! fitted PI loop is inverted analytically for feed-forward.
+
+use std::path::Path;
+
+use hil_sim::fit::{fit, Dataset, FitOptions, FitResult};
+use hil_sim::quality;
+use hil_sim::recording::Recording;
+use hil_sim::replay::Channels;
+use hil_sim::scenario::Scenario;
+use model_core::models::prandtl_ishlinskii::PrandtlIshlinskii;
+use model_core::{Kin, Model};
+
+/// Record built-in scenario `name` (shortened to `duration` s when given) and split it
+/// like `hil-sim fit` does (flagged samples excluded).
+fn dataset(name: &str, duration: Option<f64>, ch: &Channels, train: f64) -> Dataset {
+    let mut sc = Scenario::builtin(name).expect("built-in scenario");
+    if let Some(d) = duration {
+        sc.duration_s = d;
+    }
+    let rec = sc.record().expect("simulation");
+    let recording = Recording::parse_csv(Path::new(&format!("{name}.csv")), rec.csv.as_bytes()).expect("csv");
+    let q = quality::check(&recording, ch).expect("quality checks");
+    Dataset::new(&recording, ch, train, Some(q.excluded())).expect("dataset")
+}
+
+fn channels(input: &str, command: Option<&str>) -> Channels {
+    Channels { input: input.into(), command: command.map(Into::into), ..Channels::default() }
+}
+
+fn fit_all(data: &Dataset, ids: &[&str]) -> Vec<FitResult> {
+    ids.iter().map(|id| fit(id, data, &FitOptions::default()).unwrap_or_else(|e| panic!("{id}: {e}"))).collect()
+}
+
+#[test]
+fn field_level_models_reach_r2_08_on_the_multisine() {
+    // Hall B in, torque out; the coil current is the command (the Dahl model's
+    // command-dependent terms); the scenario as `hil-sim simulate --scenario multisine` records it (40 s).
+    let data = dataset("multisine", None, &channels("b", Some("i")), 0.7);
+    let ids = [
+        "algebraic",
+        "bouc_wen",
+        "lugre",
+        "tanh",
+        "dahl",
+        "hammerstein_wiener",
+        "narx",
+        "preisach",
+        "prandtl_ishlinskii",
+        "gpi",
+        "maxwell_slip",
+        "bouc_wen_asym",
+    ];
+    let results = fit_all(&data, &ids);
+    let mut low = Vec::new();
+    for r in &results {
+        eprintln!(
+            "{:<20} held-out R² {:.4}  GOF {:.4}  fit {:.2} s",
+            r.model, r.heldout.r2, r.heldout.gof, r.fit_seconds
+        );
+        assert!(r.heldout.n > 1000, "{}: held-out part not scored", r.model);
+        assert_eq!(r.output.len(), data.len(), "{}: not replayed over the recording", r.model);
+        if r.heldout.r2.is_nan() || r.heldout.r2 < 0.8 {
+            low.push(format!("{}: {:.4}", r.model, r.heldout.r2));
+        }
+    }
+    assert!(low.is_empty(), "held-out R² below 0.8: {low:?}");
+}
+
+#[test]
+fn asymmetric_loop_needs_an_asymmetric_model_and_pi_inverts() {
+    let data = dataset("triangle_asym", None, &channels("i", None), 0.7);
+    let results = fit_all(&data, &["gpi", "preisach", "prandtl_ishlinskii", "bouc_wen"]);
+    let gof = |id: &str| results.iter().find(|r| r.model == id).map(|r| r.heldout.gof).unwrap_or(f64::NAN);
+    for r in &results {
+        eprintln!("{:<20} held-out GOF {:.4}  R² {:.4}", r.model, r.heldout.gof, r.heldout.r2);
+    }
+    for id in ["gpi", "preisach"] {
+        assert!(gof(id) >= 0.95, "{id}: GOF {:.4} < 0.95", gof(id));
+    }
+    for id in ["prandtl_ishlinskii", "bouc_wen"] {
+        // "Visibly" worse: below seed 004's 0.90 line for an adequate model, and well below
+        // the asymmetric ones.
+        assert!(gof(id) < 0.9 && gof(id) < gof("gpi") - 0.05, "{id}: GOF {:.4} is not visibly lower", gof(id));
+    }
+
+    // Feed-forward with the fitted classical PI model: the measured torque is the desired
+    // output, its analytical inverse gives the current to command, and the forward model
+    // driven by that current reproduces the desired torque.
+    let pi = results.iter().find(|r| r.model == "prandtl_ishlinskii").expect("PI fitted");
+    let flat: Vec<f32> = pi.flat.iter().map(|v| *v as f32).collect();
+    let m = PrandtlIshlinskii::<10>::from_params(&flat, data.dt as f32).expect("valid PI set");
+    let inv = m.inverse().expect("fitted PI keeps p0 > 0");
+    let x0 = data.input[0] as f32;
+    let fwd0 = m.initial_state(&Kin::new(x0, 0.0, 0.0, 0.0));
+    let mut s_inv = inv.state_from(&fwd0);
+    let mut s_fwd = fwd0;
+    let desired: Vec<f32> = data.output.iter().map(|v| *v as f32).collect();
+    let (lo, hi) = desired.iter().fold((f32::MAX, f32::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+    let mut worst = 0.0f32;
+    for &yd in &desired {
+        let x = inv.step(&mut s_inv, yd);
+        assert!(x.is_finite());
+        let y = m.step(&mut s_fwd, &Kin::new(x, 0.0, 0.0, 0.0));
+        worst = worst.max((y - yd).abs());
+    }
+    assert!(worst <= 2e-3 * (hi - lo), "inverse then forward misses the desired torque by {worst} N·m");
+}
