@@ -23,9 +23,16 @@ pub struct SwarmOptions {
     pub keep: usize,
 }
 
+impl SwarmOptions {
+    /// The wider search a fit falls back to when the default finds no valid point.
+    pub fn wide(seed: u64) -> Self {
+        Self { particles: 48, iterations: 20, seed, keep: 3 }
+    }
+}
+
 impl Default for SwarmOptions {
     fn default() -> Self {
-        Self { particles: 24, iterations: 12, seed: 1, keep: 2 }
+        Self { particles: 16, iterations: 12, seed: 1, keep: 1 }
     }
 }
 

@@ -482,7 +482,40 @@ fn identify(
             let window_rows: Vec<usize> = rows.iter().copied().filter(|&i| i < opts.swarm_window).collect();
             let window_rows = if window_rows.len() < 20 { rows.to_vec() } else { window_rows };
             let win = Objective::new(sim, sp, kin, y, &window_rows, y_scale);
-            let mut cands = global::search(&win, opts.swarm)
+            let first = global_search(id, sp, &win, &full, opts, opts.swarm)?;
+            // A box where the small swarm found nothing valid (a start that is not a
+            // published set, a narrow valid region) gets a wider search before giving up.
+            let (best, mut evals) = match first {
+                (Some(best), evals) => (best, evals),
+                (None, evals) => {
+                    let wide = SwarmOptions::wide(opts.swarm.seed);
+                    match global_search(id, sp, &win, &full, opts, wide)? {
+                        (Some(best), more) => (best, evals + more),
+                        (None, _) => return Err(FitError::NoValidSet { model: id.to_owned() }),
+                    }
+                }
+            };
+            let r = lm::minimize(&full, &best.params, opts.lm_iterations);
+            evals += r.evaluations;
+            valid_or_err(id, sim, r.params, evals)
+        }
+    }
+}
+
+/// The global phase of [`Strategy::Global`]: swarm on the window, then every candidate and
+/// the papers' start polished there. Returns the candidate with the lowest cost on the whole
+/// training part (`None` when none is valid) and the evaluations spent.
+fn global_search(
+    id: &str,
+    sp: &ModelSpec,
+    win: &Objective<'_>,
+    full: &Objective<'_>,
+    opts: &FitOptions,
+    swarm: SwarmOptions,
+) -> Result<(Option<lm::LocalFit>, usize), FitError> {
+    {
+        {
+            let mut cands = global::search(win, swarm)
                 .map_err(|e| FitError::Swarm { model: id.to_owned(), reason: e.to_string() })?;
             // The papers' starting values are always polished too: they are often in the
             // right basin already (Spencer's published set on the Dyke files is), and the
@@ -497,17 +530,14 @@ fn identify(
             let polished: Vec<lm::LocalFit> = cands
                 .par_iter()
                 .map(|c| {
-                    let r = lm::minimize(&win, &c.params, opts.polish_iterations);
+                    let r = lm::minimize(win, &c.params, opts.polish_iterations);
                     lm::LocalFit { cost: full.cost(&r.params), evaluations: r.evaluations + 1, ..r }
                 })
                 .collect();
-            let mut evals = opts.swarm.particles * (opts.swarm.iterations as usize + 1)
+            let evals = swarm.particles * (swarm.iterations as usize + 1)
                 + polished.iter().map(|r| r.evaluations).sum::<usize>();
             let best = polished.into_iter().filter(|r| r.cost.is_finite()).min_by(|a, b| a.cost.total_cmp(&b.cost));
-            let start = best.map(|b| b.params).ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
-            let r = lm::minimize(&full, &start, opts.lm_iterations);
-            evals += r.evaluations;
-            valid_or_err(id, sim, r.params, evals)
+            Ok((best, evals))
         }
     }
 }

@@ -1,6 +1,8 @@
 //! The least-squares objective every optimiser shares: run the core over the training
 //! part, compare with the measurement on the rows that count.
 
+use std::sync::{Arc, Mutex};
+
 use model_core::Kin;
 
 use super::simulate::Simulator;
@@ -27,6 +29,9 @@ pub struct Objective<'a> {
     pub scale: f64,
     /// Indices of the free parameters.
     pub free: Vec<usize>,
+    /// The kinematics shifted by the delays last asked for: a Jacobian's columns for the
+    /// model's own parameters all share one pair of delays.
+    shifted: Mutex<Option<((f64, f64), Arc<Vec<Kin>>)>>,
 }
 
 impl<'a> Objective<'a> {
@@ -40,7 +45,17 @@ impl<'a> Objective<'a> {
     ) -> Self {
         let end = rows.last().map_or(0, |r| r + 1).min(kin.len());
         let ext = (end + MAX_DELAY_SAMPLES.ceil() as usize + 1).min(kin.len());
-        Self { sim, spec, kin: &kin[..ext], end, y, rows, scale: scale.max(1e-300), free: spec.free() }
+        Self {
+            sim,
+            spec,
+            kin: &kin[..ext],
+            end,
+            y,
+            rows,
+            scale: scale.max(1e-300),
+            free: spec.free(),
+            shifted: Mutex::new(None),
+        }
     }
 
     /// The model's own parameters of a full vector `p` (without the delay entry).
@@ -77,8 +92,7 @@ impl<'a> Objective<'a> {
         let ok = if d == 0.0 && d_u == 0.0 {
             self.sim.run(self.model_params(p), self.kin.get(..self.end)?, &mut out)
         } else {
-            let mut shifted = Vec::with_capacity(self.kin.len());
-            shift_kin(self.kin, d, d_u, &mut shifted);
+            let shifted = self.shifted_by(d, d_u);
             self.sim.run(self.model_params(p), shifted.get(..self.end)?, &mut out)
         };
         if !ok {
@@ -86,6 +100,23 @@ impl<'a> Objective<'a> {
         }
         let inv = 1.0 / self.scale;
         self.rows.iter().map(|&i| Some((out.get(i)? - self.y.get(i)?) * inv)).collect()
+    }
+
+    /// The kinematics shifted by `(d, d_u)` samples, from the cache when the delays are the
+    /// ones last asked for.
+    fn shifted_by(&self, d: f64, d_u: f64) -> Arc<Vec<Kin>> {
+        if let Ok(cache) = self.shifted.lock() {
+            if let Some((_, kin)) = cache.as_ref().filter(|(key, _)| *key == (d, d_u)) {
+                return Arc::clone(kin);
+            }
+        }
+        let mut shifted = Vec::with_capacity(self.kin.len());
+        shift_kin(self.kin, d, d_u, &mut shifted);
+        let shifted = Arc::new(shifted);
+        if let Ok(mut cache) = self.shifted.lock() {
+            *cache = Some(((d, d_u), Arc::clone(&shifted)));
+        }
+        shifted
     }
 
     /// Mean squared scaled residual (∞ when invalid).
