@@ -513,33 +513,29 @@ fn global_search(
     opts: &FitOptions,
     swarm: SwarmOptions,
 ) -> Result<(Option<lm::LocalFit>, usize), FitError> {
-    {
-        {
-            let mut cands = global::search(win, swarm)
-                .map_err(|e| FitError::Swarm { model: id.to_owned(), reason: e.to_string() })?;
-            // The papers' starting values are always polished too: they are often in the
-            // right basin already (Spencer's published set on the Dyke files is), and the
-            // swarm offers the alternatives.
-            let start = sp.start();
-            if !cands.iter().any(|c| c.params == start) {
-                cands.push(global::Candidate { cost: win.cost(&start), params: start });
-            }
-            // Polish every candidate on the window (in parallel), rank them by their cost on
-            // the whole training part (one run each: the window alone does not tell
-            // near-equal basins apart), then finish the best on the whole training part.
-            let polished: Vec<lm::LocalFit> = cands
-                .par_iter()
-                .map(|c| {
-                    let r = lm::minimize(win, &c.params, opts.polish_iterations);
-                    lm::LocalFit { cost: full.cost(&r.params), evaluations: r.evaluations + 1, ..r }
-                })
-                .collect();
-            let evals = swarm.particles * (swarm.iterations as usize + 1)
-                + polished.iter().map(|r| r.evaluations).sum::<usize>();
-            let best = polished.into_iter().filter(|r| r.cost.is_finite()).min_by(|a, b| a.cost.total_cmp(&b.cost));
-            Ok((best, evals))
-        }
+    let mut cands =
+        global::search(win, swarm).map_err(|e| FitError::Swarm { model: id.to_owned(), reason: e.to_string() })?;
+    // The papers' starting values are always polished too: they are often in the
+    // right basin already (Spencer's published set on the Dyke files is), and the
+    // swarm offers the alternatives.
+    let start = sp.start();
+    if !cands.iter().any(|c| c.params == start) {
+        cands.push(global::Candidate { cost: win.cost(&start), params: start });
     }
+    // Polish every candidate on the window (in parallel), rank them by their cost on
+    // the whole training part (one run each: the window alone does not tell
+    // near-equal basins apart), then finish the best on the whole training part.
+    let polished: Vec<lm::LocalFit> = cands
+        .par_iter()
+        .map(|c| {
+            let r = lm::minimize(win, &c.params, opts.polish_iterations);
+            lm::LocalFit { cost: full.cost(&r.params), evaluations: r.evaluations + 1, ..r }
+        })
+        .collect();
+    let evals =
+        swarm.particles * (swarm.iterations as usize + 1) + polished.iter().map(|r| r.evaluations).sum::<usize>();
+    let best = polished.into_iter().filter(|r| r.cost.is_finite()).min_by(|a, b| a.cost.total_cmp(&b.cost));
+    Ok((best, evals))
 }
 
 /// Fit at every whole-sample delay in ±[`MAX_DELAY_SAMPLES`](crate::alignment::MAX_DELAY_SAMPLES)

@@ -9,6 +9,9 @@ use super::simulate::Simulator;
 use super::spec::ModelSpec;
 use crate::alignment::{shift_kin, MAX_DELAY_SAMPLES};
 
+/// Kinematics shifted by an (input, command) delay pair, in samples.
+type ShiftedKin = ((f64, f64), Arc<Vec<Kin>>);
+
 /// Residuals of one model on one stretch of data.
 ///
 /// The model runs over every sample from the start of `kin` (its state must see the
@@ -31,7 +34,7 @@ pub struct Objective<'a> {
     pub free: Vec<usize>,
     /// The kinematics shifted by the delays last asked for: a Jacobian's columns for the
     /// model's own parameters all share one pair of delays.
-    shifted: Mutex<Option<((f64, f64), Arc<Vec<Kin>>)>>,
+    shifted: Mutex<Option<ShiftedKin>>,
 }
 
 impl<'a> Objective<'a> {
