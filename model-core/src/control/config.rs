@@ -557,7 +557,7 @@ impl ValidatedConfig {
     /// Fault injection: flip one bit of the RAM copy (as a radiation upset or a stray
     /// write would) without updating the CRC. Bit `n` of the encoding after the mode
     /// word (taken modulo its length). Exists so tests and the simulator can prove the
-    /// running CRC check; the firmware never calls it.
+    /// running check ([`verify`](Self::verify)); the firmware never calls it.
     pub fn inject_bit_flip(&mut self, n: u32) {
         let mut w = self.cfg.to_words();
         let bits = 32 * (WORDS as u32 - 1);

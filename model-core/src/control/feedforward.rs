@@ -38,6 +38,8 @@ pub fn invert<F: Fn(f32) -> f32>(f: F, target: f32, x0: f32, lo: f32, hi: f32, i
 #[inline(always)]
 pub fn inverse_slope<F: Fn(f32) -> f32>(f: F, x: f32, h: f32) -> f32 {
     let den = f(x + h) - f(x);
+    // `den − den` is 0 exactly when `den` is finite (one subtraction and a compare).
+    #[allow(clippy::eq_op)]
     if den - den == 0.0 {
         h / den
     } else {

@@ -168,6 +168,7 @@ pub struct ControlStep<M: Model> {
 
 /// `x` if finite, else `alt` (one subtraction and a compare).
 #[inline(always)]
+#[allow(clippy::eq_op)]
 fn finite_or(x: f32, alt: f32) -> f32 {
     if x - x == 0.0 {
         x
@@ -557,7 +558,7 @@ mod tests {
     }
 
     #[test]
-    fn corrupted_config_trips_within_two_scrub_passes() {
+    fn corrupted_config_trips_at_the_next_slow_pass() {
         // Current mode at 0 A: nothing else can trip while the coil is not simulated.
         let (step, mut cfg) = setup(LoopMode::Current);
         let mut s = step.state();

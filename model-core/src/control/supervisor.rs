@@ -42,7 +42,7 @@ pub enum FaultCode {
     SupplyLow = 7,
     /// Supply above `v_max`.
     SupplyHigh = 8,
-    /// The running CRC of the configuration does not match.
+    /// The running check of the configuration (fingerprint, coefficients) failed.
     ConfigCrc = 9,
     /// The torque model produced NaN/Inf (or overflowed) on consecutive samples.
     ModelNonFinite = 10,
@@ -170,9 +170,9 @@ pub fn fast_code_inline(k: &Coeffs, f: &Fast) -> FaultCode {
         FaultCode::HallShort
     } else if crate::math::abs(f.i) > k.over_current {
         FaultCode::OverCurrent
-    } else if !(f.supply_v >= k.v_min) {
+    } else if f.supply_v.is_nan() || f.supply_v < k.v_min {
         FaultCode::SupplyLow
-    } else if !(f.supply_v <= k.v_max) {
+    } else if f.supply_v > k.v_max {
         FaultCode::SupplyHigh
     } else if f.overrun {
         FaultCode::Overrun
