@@ -175,10 +175,11 @@ async fn main(spawner: Spawner) {
     let can = can.into_normal_mode();
 
     let iwdg = IndependentWatchdog::new(b.iwdg, board::WATCHDOG_US);
-    match (telemetry(), commands(can, flash)) {
-        (Ok(t), Ok(c)) => {
+    match (telemetry(), commands(can, flash), supervisor()) {
+        (Ok(t), Ok(c), Ok(s)) => {
             spawner.spawn(t);
             spawner.spawn(c);
+            spawner.spawn(s);
         }
         _ => defmt::panic!("spawning tasks"),
     }
@@ -201,6 +202,17 @@ async fn watchdog(mut iwdg: IndependentWatchdog<'static, embassy_stm32::peripher
             error!("control interrupt stalled: bridge off, watchdog will reset");
         }
         last = now;
+    }
+}
+
+/// The slow supervisor pass of the control step at `SLOW_HZ` (configuration fingerprint
+/// and time step; the step trips `SupervisorStalled` if this task stops).
+#[embassy_executor::task]
+async fn supervisor() {
+    let mut ticker = Ticker::every(Duration::from_hz(controller::SLOW_HZ));
+    loop {
+        ticker.next().await;
+        controller::slow_pass();
     }
 }
 

@@ -1,7 +1,9 @@
 //! The control interrupt: ADC1's end-of-injected-sequence interrupt (the conversions are
 //! started by TIM1's TRGO2 once per PWM period) runs `model_core::control::ControlStep::step`
-//! on every sample and writes the bridge. Everything else talks to it through the atomics
-//! and the critical-section cells here.
+//! on every sample and writes the bridge. The slow supervisor pass
+//! (`ControlStep::slow`: configuration fingerprint, time step, temperature compensation)
+//! runs at [`SLOW_HZ`] from the `supervisor` task ([`slow_pass`]). Everything else talks to
+//! the interrupt through the atomics and the critical-section cells here.
 
 use core::cell::{Cell, RefCell};
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -46,6 +48,15 @@ impl Loop {
             "tanh" => make(img).map(|(s, st)| Self::Tanh(s, st))?,
             _ => return Err(PageError::WrongModel),
         })
+    }
+
+    fn slow(&mut self, cfg: &ValidatedConfig, temperature: f32) {
+        match self {
+            Self::Algebraic(s, st) => s.slow(cfg, st, temperature),
+            Self::BoucWen(s, st) => s.slow(cfg, st, temperature),
+            Self::LuGre(s, st) => s.slow(cfg, st, temperature),
+            Self::Tanh(s, st) => s.slow(cfg, st, temperature),
+        }
     }
 
     #[inline(always)]
@@ -129,6 +140,24 @@ pub static TELEMETRY: Mutex<Cell<Snapshot>> = Mutex::new(Cell::new(Snapshot {
     cycles: 0,
 }));
 
+/// Rate of the slow supervisor pass (the step trips `SupervisorStalled` after 0.1 s
+/// without one).
+pub const SLOW_HZ: u64 = 1_000;
+/// Slow passes run (telemetry).
+pub static SLOW_PASSES: AtomicU32 = AtomicU32::new(0);
+
+/// One slow supervisor pass over the running controller (a short critical section: the
+/// fingerprint of the configuration, a few hundred instructions). The board has no
+/// temperature sensor: NaN (no compensation).
+pub fn slow_pass() {
+    critical_section::with(|cs| {
+        if let Some(c) = CONTROL.borrow_ref_mut(cs).as_mut() {
+            c.lp.slow(&c.cfg, f32::NAN);
+        }
+    });
+    SLOW_PASSES.fetch_add(1, Ordering::Relaxed);
+}
+
 /// The bridge's safe state: main output enable off, so every switch takes its idle state
 /// (off; OSSI set at start-up) and the coil current decays through the body diodes. A
 /// register write through the PAC so that the panic and fault handlers can call it
@@ -181,8 +210,7 @@ fn ADC1_2() {
             reset: RESET.swap(false, Ordering::Relaxed),
             ..ControlInput::new(hall, current, supply_v, reference)
         };
-        let cfg = c.cfg;
-        let out = c.lp.step(&cfg, input);
+        let out = c.lp.step(&c.cfg, input);
         drive(c, &out);
         let n = SAMPLES.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
         let cycles = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);

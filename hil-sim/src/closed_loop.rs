@@ -5,6 +5,7 @@
 //! quantised to the timer's compare counts), and that duty is applied from the **next**
 //! sample on (one-sample computation delay); between samples the plant integrates every
 //! PWM edge ([`crate::plant`]). The true torque is the plant's.
+//! The slow supervisor pass (`ControlStep::slow`) runs every millisecond, as in the firmware.
 //!
 //! [`identify`] plays the lab: on the simulated clutch, with the same step in current
 //! mode as the current driver, it records sines and a slow triangle, fits seed 000's
@@ -223,6 +224,8 @@ pub fn run<M: Model>(
     let mut out = Run::default();
     let mut injected = false;
     let use_temp = cfg.get().temp_coeff != 0.0;
+    // The slow supervisor pass at 1 kHz, as the firmware's `supervisor` task runs it.
+    let slow_every = ((1e-3 / dt).round() as usize).max(1);
     for k in 0..n {
         let t = k as f64 * dt;
         let active = fault.filter(|f| t >= f.at).map(|f| f.injection);
@@ -243,11 +246,10 @@ pub fn run<M: Model>(
         let overrun = active == Some(Injection::Overrun);
         let m = plant.measure();
         let r = if t >= T_START { reference(t - T_START) } else { 0.0 };
-        let input = ControlInput {
-            temperature: if use_temp { m.temperature as f32 } else { f32::NAN },
-            overrun,
-            ..ControlInput::new(m.hall, m.current, m.supply_v as f32, r as f32)
-        };
+        if k % slow_every == 0 {
+            step.slow(&cfg, &mut st, if use_temp { m.temperature as f32 } else { f32::NAN });
+        }
+        let input = ControlInput { overrun, ..ControlInput::new(m.hall, m.current, m.supply_v as f32, r as f32) };
         let o = step.step(&cfg, &mut st, input);
         out.t.push(t);
         out.reference.push(r);

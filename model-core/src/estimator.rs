@@ -75,29 +75,40 @@ impl<M: Model> Estimator<M> {
     #[inline]
     pub fn step(&self, s: &mut EstimatorState<M::State>, sample: Sample) -> Output {
         let u = sample.u.unwrap_or(0.0);
-        let finite_in = sample.x.is_finite()
-            && u.is_finite()
-            && sample.dx.is_none_or(f32::is_finite)
-            && sample.ddx.is_none_or(f32::is_finite);
-        if !finite_in {
+        // `0·v` is 0 for a finite v and NaN otherwise: one test for all of them.
+        let zero_in = 0.0 * sample.x + 0.0 * u + 0.0 * sample.dx.unwrap_or(0.0) + 0.0 * sample.ddx.unwrap_or(0.0);
+        if zero_in != 0.0 {
             return self.reject(s, Flags::NON_FINITE_INPUT);
         }
-        let saved = *s;
-        let (edx, eddx) = self.rate.step(&mut s.rate, sample.x);
-        let k = Kin { x: sample.x, dx: sample.dx.unwrap_or(edx), ddx: sample.ddx.unwrap_or(eddx), u };
-        if !k.is_finite() || !s.rate.is_finite() {
-            *s = saved;
+        self.advance(s, sample.x, sample.dx, sample.ddx, u)
+    }
+
+    /// [`step`](Self::step) for a sample of input `x` and command `u` without measured
+    /// rates, known to be finite (the control step's ADC counts times validated gains):
+    /// the same result without the input test. A non-finite `x` is still rejected (as
+    /// [`Flags::OVERFLOW`]: the rate estimate turns non-finite).
+    #[inline]
+    pub fn step_finite(&self, s: &mut EstimatorState<M::State>, x: f32, u: f32) -> Output {
+        self.advance(s, x, None, None, u)
+    }
+
+    #[inline(always)]
+    fn advance(&self, s: &mut EstimatorState<M::State>, x: f32, dx: Option<f32>, ddx: Option<f32>, u: f32) -> Output {
+        // Work on copies and commit only a good step (a rejected one changes nothing).
+        let mut rate = s.rate;
+        let (edx, eddx) = self.rate.step(&mut rate, x);
+        let k = Kin { x, dx: dx.unwrap_or(edx), ddx: ddx.unwrap_or(eddx), u };
+        let mut model = if s.started { s.model } else { self.model.initial_state(&k) };
+        let y = self.model.step(&mut model, &k);
+        // The estimated rates are the estimator's new state (every `RateParams` variant
+        // returns what it stores); measured ones were checked on the way in.
+        let zero = 0.0 * y + 0.0 * rate.x + 0.0 * rate.dx + 0.0 * rate.ddx;
+        if zero != 0.0 || !model.is_finite() {
             return self.reject(s, Flags::OVERFLOW);
         }
-        if !s.started {
-            s.model = self.model.initial_state(&k);
-            s.started = true;
-        }
-        let y = self.model.step(&mut s.model, &k);
-        if !y.is_finite() || !s.model.is_finite() {
-            *s = saved;
-            return self.reject(s, Flags::OVERFLOW);
-        }
+        s.rate = rate;
+        s.model = model;
+        s.started = true;
         s.last = y;
         Output { y, flags: Flags(0) }
     }

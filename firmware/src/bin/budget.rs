@@ -13,7 +13,9 @@
 //!    that visits every branch that matters there (rest, travel, reversals, zero crossings
 //!    of the hysteretic state, sign changes of the input; for the control step:
 //!    calibration, running with a multi-sine reference, reference limiting, the
-//!    demagnetising pulse, disable/enable);
+//!    demagnetising pulse, disable/enable, a Hall rail fault with its trip, reset and
+//!    recalibration; the slow supervisor pass `supervisor_slow` every 20th sample, as the
+//!    firmware runs it at 1 kHz);
 //! 3. prints `outside <name> <address> <calls>` and runs a second sweep beyond the
 //!    envelope (500 Hz full-span sine, jumps of the whole span in one sample), which
 //!    `hil-sim budget` reports apart, without a budget.
@@ -237,6 +239,7 @@ mod bench {
 
     type Step = ControlStep<algebraic::Algebraic>;
     type StepFn = fn(&Step, &ValidatedConfig, &mut ControlState<()>, ControlInput) -> ControlOutput;
+    type SlowFn = fn(&Step, &ValidatedConfig, &mut ControlState<()>, f32);
 
     /// The firmware's control step with its compiled-in default model (the algebraic model
     /// in T, as `hil-sim loop` identifies it) against a crude RL coil with B ∝ i.
@@ -255,8 +258,12 @@ mod bench {
         };
         let Ok(cfg) = cfg.validate() else { fail("control config") };
         let f: StepFn = black_box(Step::step);
-        const N: u32 = 400;
+        let slow: SlowFn = black_box(Step::slow);
+        const N: u32 = 440;
+        /// The slow pass runs before every `SLOW`-th sample (1 kHz at 20 kHz).
+        const SLOW: u32 = 20;
         hprintln!("step control_step {:#x} {}", f as usize, N);
+        hprintln!("step supervisor_slow {:#x} {}", slow as usize, N.div_ceil(SLOW));
         let mut s = step.state();
         let (r_coil, l_coil, supply) = (4.0f32, 0.02f32, 24.0f32);
         let c = *cfg.get();
@@ -264,7 +271,9 @@ mod bench {
         for k in 0..N {
             let t = k as f32 * DT;
             // Reference: 0 while calibrating, a fast multi-sine 2–14 N·m (beyond the 15 N·m
-            // limit at its peaks), back to 0 (demagnetising pulse), disabled, enabled.
+            // limit at its peaks), back to 0 (demagnetising pulse), disabled, enabled; then
+            // the Hall output at its upper rail (trips on the third sample), reset, and a
+            // recalibration once the next slow pass has run.
             let reference = match k {
                 0..=20 => 0.0,
                 21..=300 => {
@@ -276,13 +285,16 @@ mod bench {
             };
             let b = 0.2 * i;
             let noise = (k % 3) as f32;
-            let hall = (c.hall_offset + b / c.hall_gain + noise) as u16;
+            let hall = if (380..386).contains(&k) { 4095 } else { (c.hall_offset + b / c.hall_gain + noise) as u16 };
             let current = (c.current_offset + i / c.current_gain + noise) as u16;
             let input = ControlInput {
-                temperature: 40.0,
                 enable: !(340..350).contains(&k),
+                reset: k == 390,
                 ..ControlInput::new(hall, current, supply, if k == 200 { 30.0 } else { reference })
             };
+            if k % SLOW == 0 {
+                slow(black_box(&step), black_box(&cfg), &mut s, black_box(40.0));
+            }
             let o = black_box(f(black_box(&step), black_box(&cfg), &mut s, black_box(input)));
             let v = if o.pwm_enable { o.duty * supply } else { 0.0 };
             i += DT * (v - r_coil * i) / l_coil;

@@ -4,12 +4,18 @@
 //! returns a [`ValidatedConfig`] that carries the CRC-32 (IEEE 802.3, reflected,
 //! polynomial 0xEDB88320) of its byte encoding ([`ControlConfig::to_words`], each word
 //! little-endian f32). The firmware stores [`ValidatedConfig::to_bytes`] in flash and
-//! reads it back with [`ValidatedConfig::from_bytes`], which rejects a CRC mismatch. While
-//! running, the supervisor re-computes a fingerprint of the RAM copy a few words per sample
-//! ([`SCRUB_WORDS`], [`fingerprint_step`]: rotate and xor, which catches any single-bit
-//! upset at a fraction of the CRC's cost) and trips
+//! reads it back with [`ValidatedConfig::from_bytes`], which rejects a CRC mismatch.
+//!
+//! Validation also pre-computes everything the per-sample step needs in the form it needs
+//! it ([`Coeffs`]: integral gains times `dt`, reciprocals, limits as integer counts, the
+//! disabled checks as unreachable limits), so the step does no division by a setting and
+//! no per-sample conversion of one. While running, the slow supervisor
+//! ([`ControlStep::slow`](super::ControlStep::slow), about 1 kHz) re-computes a
+//! fingerprint of the RAM copy ([`ValidatedConfig::verify`], [`fingerprint_step`]: rotate
+//! and xor, which catches any single-bit upset at a fraction of the CRC's cost) and checks
+//! the coefficients against the settings, and trips
 //! [`FaultCode::ConfigCrc`](super::FaultCode::ConfigCrc) on a mismatch, so a corrupted
-//! setting is caught within two passes (< 2 ms at 10 kHz).
+//! setting is caught within one slow period after the upset.
 
 use crate::error::{check, time_step};
 use crate::ParamError;
@@ -126,8 +132,6 @@ pub struct ControlConfig {
 
 /// Bytes of [`ValidatedConfig::to_bytes`]: the words and the CRC.
 pub const BYTES: usize = 4 * WORDS + 4;
-/// Words the running check covers per sample.
-pub const SCRUB_WORDS: usize = 8;
 
 /// One word into the running fingerprint of the RAM copy: rotate, xor. Linear over GF(2)
 /// with a bijective rotation, so any single flipped bit (and any odd number of flips in one
@@ -333,7 +337,125 @@ impl ControlConfig {
         let words = self.to_words();
         let crc = crc_words(&words);
         let fingerprint = words.iter().fold(SCRUB_SEED, |a, w| fingerprint_step(a, *w));
-        Ok(ValidatedConfig { cfg: self, crc, fingerprint })
+        Ok(ValidatedConfig { cfg: self, k: Coeffs::new(&self), crc, fingerprint })
+    }
+}
+
+/// What the per-sample step reads, pre-computed once from a validated [`ControlConfig`]
+/// ([`Coeffs::new`]; the slow supervisor re-computes it and compares). Units as in
+/// [`ControlConfig`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Coeffs {
+    pub mode: LoopMode,
+    /// T per count, A per count.
+    pub hall_gain: f32,
+    pub current_gain: f32,
+    /// Hall counts in range: `hall − rail_base < rail_span` (wrapping, u32), i.e.
+    /// `hall_rail_lo < hall < hall_rail_hi`.
+    pub rail_base: u32,
+    pub rail_span: u32,
+    /// Hall counts at or above this are the upper rail (`⌈hall_rail_hi⌉`).
+    pub rail_hi: u32,
+    /// Over-current trip, A; supply window, V.
+    pub over_current: f32,
+    pub v_min: f32,
+    pub v_max: f32,
+    /// Consecutive samples a fast condition (rail, over-current, supply, overrun, model)
+    /// must persist.
+    pub confirm: u32,
+    /// Samples of the slow-developing checks (`u32::MAX`: disabled).
+    pub stuck_n: u32,
+    pub open_n: u32,
+    pub band_n: u32,
+    /// Reversing Hall jumps within 8 samples that trip the noise check.
+    pub slew_n: u32,
+    /// Largest plausible Hall change per sample in counts (`b_slew_max/hall_gain`).
+    pub slew_counts: u32,
+    /// Coil-open check: V, A.
+    pub open_v: f32,
+    pub open_i: f32,
+    /// Plausibility band, T (`+∞`: disabled), and the B/i slope, T/A.
+    pub b_band: f32,
+    pub b_per_amp: f32,
+    /// `1/b_per_amp`, A/T; current lead `ff_lead_s/dt` (1).
+    pub amp_per_b: f32,
+    pub lead: f32,
+    /// Feed-forward: the range of B* (`[0, b_max − h]`, T), the forward-difference width
+    /// `h = 10⁻³·b_max` (T), the largest Newton step (T).
+    pub ff_hi: f32,
+    pub ff_h: f32,
+    pub ff_step: f32,
+    /// Reference limit (N·m, or A in current mode) and the current limit, A.
+    pub ref_lim: f32,
+    pub i_max: f32,
+    /// Torque PI: A/(N·m), A/(N·m) per sample; current PI: V/A, V/A per sample.
+    pub kp_t: f32,
+    pub ki_t_dt: f32,
+    pub kp_i: f32,
+    pub ki_i_dt: f32,
+    /// Coil resistance, Ω.
+    pub coil_r: f32,
+    /// Largest |duty|, PWM counts for duty 1.
+    pub duty_max: f32,
+    pub pwm_counts: f32,
+    /// Demagnetising pulse: duty, samples, arming threshold and its quarter.
+    pub demag_duty: f32,
+    pub demag_samples: u16,
+    pub demag_threshold: f32,
+    /// Samples without a slow-supervisor pass before the step trips
+    /// [`FaultCode::SupervisorStalled`](super::FaultCode::SupervisorStalled) (0.1 s).
+    pub slow_timeout: u32,
+}
+
+/// The slow supervisor must pass at least this often (s).
+pub const SLOW_TIMEOUT_S: f32 = 0.1;
+
+impl Coeffs {
+    /// Pre-compute from settings that passed [`ControlConfig::validate`].
+    pub fn new(c: &ControlConfig) -> Self {
+        let count = |n: f32| if n > 0.0 { n as u32 } else { 0 };
+        let rail_lo = libm::floorf(c.hall_rail_lo) as u32;
+        let rail_hi = libm::ceilf(c.hall_rail_hi) as u32;
+        let h = 1e-3 * c.b_max;
+        Self {
+            mode: c.mode,
+            hall_gain: c.hall_gain,
+            current_gain: c.current_gain,
+            rail_base: rail_lo.saturating_add(1),
+            rail_span: rail_hi.saturating_sub(rail_lo.saturating_add(1)),
+            rail_hi,
+            over_current: c.over_current,
+            v_min: c.v_min,
+            v_max: c.v_max,
+            confirm: count(c.confirm_samples),
+            stuck_n: if c.stuck_samples > 0.0 { count(c.stuck_samples) } else { u32::MAX },
+            open_n: count(c.open_samples),
+            band_n: count(c.band_samples),
+            slew_n: count(c.slew_count),
+            slew_counts: (c.b_slew_max / c.hall_gain) as u32,
+            open_v: c.open_v,
+            open_i: c.open_i,
+            b_band: if c.b_band > 0.0 { c.b_band } else { f32::INFINITY },
+            b_per_amp: c.b_per_amp,
+            amp_per_b: 1.0 / c.b_per_amp,
+            lead: c.ff_lead_s / c.dt,
+            ff_hi: c.b_max - h,
+            ff_h: h,
+            ff_step: 0.25 * c.b_max,
+            ref_lim: if c.mode == LoopMode::Current { c.i_max } else { c.torque_max },
+            i_max: c.i_max,
+            kp_t: c.kp_t,
+            ki_t_dt: c.ki_t * c.dt,
+            kp_i: c.kp_i,
+            ki_i_dt: c.ki_i * c.dt,
+            coil_r: c.coil_r,
+            duty_max: c.duty_max,
+            pwm_counts: c.pwm_counts,
+            demag_duty: c.demag_duty,
+            demag_samples: count(c.demag_samples).min(u32::from(u16::MAX)) as u16,
+            demag_threshold: c.demag_threshold,
+            slow_timeout: count(libm::ceilf(SLOW_TIMEOUT_S / c.dt)),
+        }
     }
 }
 
@@ -342,6 +464,7 @@ impl ControlConfig {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ValidatedConfig {
     cfg: ControlConfig,
+    k: Coeffs,
     crc: u32,
     fingerprint: u32,
 }
@@ -381,6 +504,21 @@ impl ValidatedConfig {
     pub const fn get(&self) -> &ControlConfig {
         &self.cfg
     }
+    /// The pre-computed coefficients of the per-sample step.
+    #[inline(always)]
+    pub const fn coeffs(&self) -> &Coeffs {
+        &self.k
+    }
+    /// The running check of the RAM copy: the fingerprint of the settings' encoding
+    /// matches the one taken at validation and the coefficients are the ones the
+    /// settings give. False after any single-bit upset of either.
+    pub fn verify(&self) -> bool {
+        let mut acc = SCRUB_SEED;
+        for i in 0..WORDS {
+            acc = fingerprint_step(acc, self.cfg.word(i));
+        }
+        acc == self.fingerprint && Coeffs::new(&self.cfg) == self.k
+    }
     /// CRC-32 of the encoding as validated.
     pub const fn crc(&self) -> u32 {
         self.crc
@@ -419,7 +557,7 @@ impl ValidatedConfig {
     /// Fault injection: flip one bit of the RAM copy (as a radiation upset or a stray
     /// write would) without updating the CRC. Bit `n` of the encoding after the mode
     /// word (taken modulo its length). Exists so tests and the simulator can prove the
-    /// running CRC check; the firmware never calls it.
+    /// running check ([`verify`](Self::verify)); the firmware never calls it.
     pub fn inject_bit_flip(&mut self, n: u32) {
         let mut w = self.cfg.to_words();
         let bits = 32 * (WORDS as u32 - 1);
@@ -469,60 +607,6 @@ pub fn crc32_update(mut crc: u32, bytes: &[u8]) -> u32 {
     crc
 }
 
-/// Running check of the RAM copy, [`SCRUB_WORDS`] words per call.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Scrub {
-    pub pos: u16,
-    pub acc: u32,
-}
-
-impl Default for Scrub {
-    fn default() -> Self {
-        Self { pos: 0, acc: SCRUB_SEED }
-    }
-}
-
-impl Scrub {
-    /// Advance over the next words of `cfg`; at the end of a pass returns whether the
-    /// fingerprint matched, otherwise `None`.
-    #[inline]
-    pub fn step(&mut self, cfg: &ValidatedConfig) -> Option<bool> {
-        let block = usize::from(self.pos) / SCRUB_WORDS;
-        self.acc = cfg.cfg.fold_block(block, self.acc);
-        self.pos = self.pos.saturating_add(SCRUB_WORDS as u16);
-        if usize::from(self.pos) >= WORDS {
-            let ok = self.acc == cfg.fingerprint;
-            *self = Self::default();
-            Some(ok)
-        } else {
-            None
-        }
-    }
-}
-
-impl ControlConfig {
-    /// Fold words `8·block .. 8·block + 8` (those that exist) into the fingerprint. The
-    /// array is taken apart by a pattern with constant positions, so the compiler reads
-    /// only the eight fields of the block (no copy of the whole configuration).
-    #[inline(always)]
-    fn fold_block(&self, block: usize, acc: u32) -> u32 {
-        let [w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11, w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23, w24, w25, w26, w27, w28, w29, w30, w31, w32, w33, w34, w35, w36, w37, w38, w39, w40, w41, w42, w43] =
-            self.to_words();
-        let ws: [f32; SCRUB_WORDS] = match block {
-            0 => [w0, w1, w2, w3, w4, w5, w6, w7],
-            1 => [w8, w9, w10, w11, w12, w13, w14, w15],
-            2 => [w16, w17, w18, w19, w20, w21, w22, w23],
-            3 => [w24, w25, w26, w27, w28, w29, w30, w31],
-            4 => [w32, w33, w34, w35, w36, w37, w38, w39],
-            _ => {
-                // The last block has four words: fold just those.
-                return [w40, w41, w42, w43].iter().fold(acc, |a, w| fingerprint_step(a, *w));
-            }
-        };
-        ws.iter().fold(acc, |a, w| fingerprint_step(a, *w))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     #![allow(clippy::unwrap_used)]
@@ -559,24 +643,18 @@ mod tests {
     }
 
     #[test]
-    fn scrub_finds_a_flipped_bit_within_one_pass_after_the_flip() {
+    fn verify_finds_any_flipped_bit() {
         let v = ControlConfig::defaults(1e-4).validate().unwrap();
-        let mut s = Scrub::default();
-        let passes = WORDS.div_ceil(SCRUB_WORDS);
-        for _ in 0..passes - 1 {
-            assert_eq!(s.step(&v), None);
-        }
-        assert_eq!(s.step(&v), Some(true));
+        assert!(v.verify());
         for bit in [0u32, 31, 500, 1407] {
             let mut bad = v;
             bad.inject_bit_flip(bit);
             assert_ne!(bad.get().to_words().map(f32::to_bits), v.get().to_words().map(f32::to_bits), "bit {bit}");
-            let mut s = Scrub::default();
-            let mut res = None;
-            for _ in 0..passes {
-                res = s.step(&bad).or(res);
-            }
-            assert_eq!(res, Some(false), "bit {bit}");
+            assert!(!bad.verify(), "bit {bit}");
         }
+        // A stray write to a coefficient (not to the settings) is caught too.
+        let mut bad = v;
+        bad.k.ki_i_dt = f32::from_bits(bad.k.ki_i_dt.to_bits() ^ 1);
+        assert!(!bad.verify());
     }
 }

@@ -32,6 +32,52 @@ pub fn invert<F: Fn(f32) -> f32>(f: F, target: f32, x0: f32, lo: f32, hi: f32, i
     x
 }
 
+/// The reciprocal slope `h/(f(x + h) − f(x))` of `f` at `x` for [`chord_step`]: `±∞`
+/// for a flat `f` (a full step towards the target, as for a rising `f`), 0 when `f` is not
+/// finite there (no step).
+#[inline(always)]
+pub fn inverse_slope<F: Fn(f32) -> f32>(f: F, x: f32, h: f32) -> f32 {
+    let den = f(x + h) - f(x);
+    // `den − den` is 0 exactly when `den` is finite (one subtraction and a compare).
+    #[allow(clippy::eq_op)]
+    if den - den == 0.0 {
+        h / den
+    } else {
+        0.0
+    }
+}
+
+/// One bounded chord step of `f(x) = target` from `x ∈ [0, hi]` with the reciprocal slope
+/// `inv_slope` ([`inverse_slope`], taken now or a little earlier): Newton's method with a
+/// lagged derivative, one evaluation of `f` and no division. The step is limited to
+/// `±max_step`; a non-finite quotient (an infinite or NaN `f`) leaves `x`. The result is
+/// in `[0, hi]` for a finite `x`. The per-sample feed-forward: the reference moves little
+/// in one period, so one step from the last solution tracks the root.
+#[inline(always)]
+pub fn chord_step<F: Fn(f32) -> f32>(f: F, target: f32, x: f32, inv_slope: f32, hi: f32, max_step: f32) -> f32 {
+    let q = (target - f(x)) * inv_slope;
+    // NaN → no step.
+    let dx = if q >= -max_step {
+        if q <= max_step {
+            q
+        } else {
+            max_step
+        }
+    } else if q < -max_step {
+        -max_step
+    } else {
+        0.0
+    };
+    clamp(x + dx, 0.0, hi)
+}
+
+/// One bounded Newton step: [`chord_step`] with the slope taken at `x` (forward
+/// difference of width `h`; the caller keeps `hi + h` inside the domain of `f`).
+#[inline(always)]
+pub fn newton_step<F: Fn(f32) -> f32>(f: F, target: f32, x: f32, hi: f32, h: f32, max_step: f32) -> f32 {
+    chord_step(&f, target, x, inverse_slope(&f, x, h), hi, max_step)
+}
+
 /// The model's static part at its present state: output for input `x` with zero rate.
 /// Works on a copy of the state; the state itself is not advanced.
 #[inline]
@@ -80,6 +126,37 @@ mod tests {
         assert_eq!(invert(|b| static_output(&m, &(), b, 0.0), 0.0, 0.2, 0.0, 0.8, 8, 1e-4), 0.0);
         let top = invert(|b| static_output(&m, &(), b, 0.0), 1e9, 0.2, 0.0, 0.8, 8, 1e-4);
         assert!((top - 0.8).abs() < 1e-6);
+    }
+
+    #[test]
+    fn newton_steps_converge_and_stay_in_range() {
+        let m = Algebraic::new(20.0, -0.05, -2.0, 0.8, 1e-4).unwrap();
+        let f = |b: f32| static_output(&m, &(), b, 0.0);
+        let (hi, h) = (0.8f32 - 0.8e-3, 0.8e-3f32);
+        let step = |t: f32, x: f32| newton_step(f, t, x, hi, h, 0.2);
+        let mut b = 0.0;
+        for _ in 0..8 {
+            b = step(6.0, b);
+        }
+        assert!((f(b) - 6.0).abs() < 1e-3, "{b}: {}", f(b));
+        assert_eq!(step(-5.0, 0.0), 0.0);
+        assert!((step(1e9, hi) - hi).abs() < 1e-6);
+        assert!((step(1e9, 0.1) - 0.3).abs() < 1e-6, "a step is at most max_step");
+        assert_eq!(step(f32::NAN, 0.3), 0.3);
+        assert_eq!(newton_step(|_| f32::NAN, 1.0, 0.3, hi, h, 0.2), 0.3);
+        assert!((newton_step(|_| 2.0, 1.0, 0.3, hi, h, 0.2) - 0.1).abs() < 1e-6, "flat: towards the target");
+        assert_eq!(newton_step(|_| 1.0, 1.0, 0.3, hi, h, 0.2), 0.3, "flat at the target");
+        let inf = |b: f32| if b > 0.5 { f32::INFINITY } else { b };
+        assert_eq!(newton_step(inf, 1.0, 0.55, hi, 0.1, 0.2), 0.55);
+        // A lagged slope still converges (chord method).
+        let inv = inverse_slope(f, 0.1, h);
+        let mut b = 0.1;
+        for _ in 0..30 {
+            b = chord_step(f, 6.0, b, inv, hi, 0.2);
+        }
+        assert!((f(b) - 6.0).abs() < 1e-3, "{b}: {}", f(b));
+        assert_eq!(chord_step(f, 6.0, 0.2, 0.0, hi, 0.2), 0.2, "no slope, no step");
+        assert_eq!(inverse_slope(inf, 0.45, 0.1), 0.0);
     }
 
     #[test]

@@ -34,15 +34,26 @@ impl Pi {
         if !e.is_finite() {
             return clamp(ff + s.integral, self.lo, self.hi);
         }
-        let raw = ff + self.kp * e + s.integral;
-        let out = clamp(raw, self.lo, self.hi);
-        let pushes_out = (raw > self.hi && e > 0.0) || (raw < self.lo && e < 0.0);
-        if !pushes_out {
-            let i = s.integral + self.ki_dt * e;
-            s.integral = clamp(i, self.lo - ff, self.hi - ff);
-        }
-        out
+        step_limited(self.kp, self.ki_dt, s, e, ff, self.lo, self.hi)
     }
+}
+
+/// The PI step without input guards, for callers whose error and feed-forward are finite
+/// by construction (the control step): gains `kp` and `ki_dt` (`ki·T`), output limited to
+/// `[lo, hi]` (finite, `lo ≤ hi`). Output and integral stay inside their limits even for
+/// a NaN `e` (the output is then `lo`); a non-finite `ff` is the caller's error.
+#[inline(always)]
+pub fn step_limited(kp: f32, ki_dt: f32, s: &mut PiState, e: f32, ff: f32, lo: f32, hi: f32) -> f32 {
+    let raw = ff + kp * e + s.integral;
+    let out = clamp(raw, lo, hi);
+    // Saturated in the direction `e` pushes (raw > hi with e > 0, or raw < lo with e < 0):
+    // the excess and the error have the same sign.
+    let pushes_out = (raw - out) * e > 0.0;
+    if !pushes_out {
+        let i = s.integral + ki_dt * e;
+        s.integral = clamp(i, lo - ff, hi - ff);
+    }
+    out
 }
 
 /// `x` limited to `[lo, hi]`; NaN maps to `lo`.

@@ -22,6 +22,17 @@ pub fn duty(v: f32, supply: f32, duty_max: f32, counts: f32) -> (f32, i32) {
     (compare / counts, compare as i32)
 }
 
+/// Duty `d` (finite, |d| ≤ 1) quantised to `counts` ≤ 65535 per unit duty, rounded to
+/// the nearest count (halves up), without a libm call; returns `(duty, compare)`.
+#[inline(always)]
+pub fn quantise(d: f32, counts: f32) -> (f32, i32) {
+    // `as` truncates toward zero (VCVT); shifted positive by 2¹⁶ counts it is a floor, so
+    // `⌊q + ½⌋` is the nearest count.
+    const SHIFT: f32 = 65536.0;
+    let compare = (d * counts + (SHIFT + 0.5)) as i32 - SHIFT as i32;
+    (compare as f32 / counts, compare)
+}
+
 /// Demagnetising pulse settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Demag {
@@ -73,6 +84,25 @@ mod tests {
         assert_eq!(duty(-0.01234, 1.0, 0.95, 1000.0), (-0.012, -12));
         assert_eq!(duty(1.0, 0.0, 0.95, 1000.0), (0.0, 0));
         assert_eq!(duty(f32::NAN, 24.0, 0.95, 1000.0), (0.0, 0));
+    }
+
+    #[test]
+    fn quantise_rounds_to_the_nearest_count() {
+        assert_eq!(quantise(0.5, 1000.0), (0.5, 500));
+        assert_eq!(quantise(0.95, 1000.0), (0.95, 950));
+        assert_eq!(quantise(-0.95, 1000.0), (-0.95, -950));
+        assert_eq!(quantise(-0.01234, 1000.0), (-0.012, -12));
+        assert_eq!(quantise(0.0125, 1000.0).1, 13);
+        assert_eq!(quantise(-0.0125, 1000.0).1, -12);
+        assert_eq!(quantise(1.0, 65535.0).1, 65535);
+        assert_eq!(quantise(-1.0, 65535.0).1, -65535);
+        for k in -1300..=1300 {
+            let d = k as f32 * 0.000_731;
+            let (duty, c) = quantise(d, 4250.0);
+            let exact = f64::from(d) * 4250.0;
+            assert!((f64::from(c) - exact).abs() <= 0.51, "{d}: {c} for {exact}");
+            assert!((duty - c as f32 / 4250.0).abs() == 0.0);
+        }
     }
 
     #[test]

@@ -3,23 +3,36 @@
 //!
 //! Shape after quartiq's idsp/stabilizer: immutable [`ControlStep`] (the torque model and
 //! its rate estimator), plain-data [`ControlState`], settings passed in as a
-//! `&ValidatedConfig` each call so a new configuration is swapped in between two samples
-//! by replacing a `Copy` value. [`ControlStep::step`] cannot fail, allocates nothing and
-//! never emits NaN: every output field is finite for any input.
+//! `&ValidatedConfig` each call (its [`Coeffs`] pre-computed at validation) so a new
+//! configuration is swapped in between two samples by replacing a `Copy` value.
+//!
+//! Two entry points:
+//! - [`ControlStep::step`], every sample (20 kHz): cannot fail, allocates nothing and never
+//!   emits NaN: every output field is finite for any input. Its hot path (loop closed)
+//!   is straight-line code with no division by a setting; the other modes take a separate,
+//!   equally bounded path.
+//! - [`ControlStep::slow`], about 1 kHz from a lower-priority task: the checks that need
+//!   not run every sample (configuration fingerprint and coefficients, model/configuration
+//!   time step) and the temperature compensation. A fault it finds is latched and trips
+//!   the next sample; a step that sees no slow pass for
+//!   [`SLOW_TIMEOUT_S`](super::config::SLOW_TIMEOUT_S) trips
+//!   [`FaultCode::SupervisorStalled`], and the loop does not start before a first pass.
 
 use super::calibration::{counts_to_units, CalibResult, CalibState, Calibration};
-use super::config::{LoopMode, Scrub, ValidatedConfig};
-use super::feedforward::{invert, static_output, StaticMap};
-use super::pi::{clamp, Pi, PiState};
-use super::pwm::{duty, Demag, DemagState};
-use super::supervisor::{check, FaultCode, Observation, SupState};
+use super::config::{Coeffs, LoopMode, ValidatedConfig};
+use super::feedforward::{chord_step, inverse_slope, static_output, StaticMap};
+use super::pi::{clamp, step_limited, PiState};
+use super::pwm::{quantise, Demag, DemagState};
+use super::supervisor::{
+    self, confirm, fast_any, fast_any_clamped, fast_code, Fast, FaultCode, SupState, SLOW_LATCHED,
+};
 use crate::rate::RateParams;
-use crate::{Estimator, EstimatorState, Model, ParamError, Sample};
+use crate::{Estimator, EstimatorState, Model, ParamError};
 
 /// Operating mode.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Mode {
-    /// Fresh state; the next enabled sample starts the calibration.
+    /// Fresh state; the next enabled sample after a first slow pass starts the calibration.
     #[default]
     Init,
     /// Bridge off, averaging the zero-current offsets.
@@ -42,8 +55,6 @@ pub struct ControlInput {
     pub supply_v: f32,
     /// Torque reference (N·m), or coil current (A) in [`LoopMode::Current`].
     pub reference: f32,
-    /// Fluid/housing temperature, °C (NaN when there is no sensor).
-    pub temperature: f32,
     /// The previous step missed its deadline.
     pub overrun: bool,
     /// Drive allowed; false puts the bridge off without a fault.
@@ -53,9 +64,9 @@ pub struct ControlInput {
 }
 
 impl ControlInput {
-    /// An enabled sample with no temperature sensor and no overrun.
+    /// An enabled sample with no overrun.
     pub const fn new(hall: u16, current: u16, supply_v: f32, reference: f32) -> Self {
-        Self { hall, current, supply_v, reference, temperature: f32::NAN, overrun: false, enable: true, reset: false }
+        Self { hall, current, supply_v, reference, overrun: false, enable: true, reset: false }
     }
 }
 
@@ -100,18 +111,53 @@ pub struct ControlState<S> {
     pub est: EstimatorState<S>,
     pub calib: CalibState,
     pub calibrated: bool,
+    /// Zero-current offsets, counts.
     pub hall_offset: f32,
     pub current_offset: f32,
     pub pi_t: PiState,
     pub pi_i: PiState,
     pub sup: SupState,
     pub demag: DemagState,
-    pub scrub: Scrub,
     /// Voltage commanded on the previous sample, V.
     pub last_v: f32,
-    /// Previous feed-forward flux density (Newton start), T, and current, A.
+    /// Previous feed-forward flux density (Newton start, in `[0, b_max − h]`), T, and
+    /// current, A.
     pub b_star: f32,
     pub i_ff: f32,
+    /// Temperature compensation factor of the estimate (1: none), set by the slow pass
+    /// (which runs before the loop starts).
+    pub temp_scale: f32,
+    /// Coil current of the last running sample, A. The slow pass takes the model's static
+    /// part there: its torque at B = 0 (the floor of the reachable torque, N·m) and its
+    /// reciprocal slope at `b_star` (T per N·m) for the feed-forward's chord steps.
+    pub last_i: f32,
+    pub t_floor: f32,
+    pub ff_inv_slope: f32,
+}
+
+impl<S: Default> ControlState<S> {
+    /// Back to [`Default`] (mode `Init`), field by field: no state-sized temporary on the
+    /// stack of the step.
+    #[inline(never)]
+    pub fn reset(&mut self) {
+        self.mode = Mode::Init;
+        self.est = EstimatorState::default();
+        self.calib = CalibState::default();
+        self.calibrated = false;
+        self.hall_offset = 0.0;
+        self.current_offset = 0.0;
+        self.pi_t = PiState::default();
+        self.pi_i = PiState::default();
+        self.sup = SupState::default();
+        self.demag = DemagState::default();
+        self.last_v = 0.0;
+        self.b_star = 0.0;
+        self.i_ff = 0.0;
+        self.temp_scale = 0.0;
+        self.last_i = 0.0;
+        self.t_floor = 0.0;
+        self.ff_inv_slope = 0.0;
+    }
 }
 
 /// Immutable part: the torque model with its rate estimator.
@@ -120,12 +166,57 @@ pub struct ControlStep<M: Model> {
     pub est: Estimator<M>,
 }
 
+/// `x` if finite, else `alt` (one subtraction and a compare).
+#[inline(always)]
+#[allow(clippy::eq_op)]
 fn finite_or(x: f32, alt: f32) -> f32 {
-    if x.is_finite() {
+    if x - x == 0.0 {
         x
     } else {
         alt
     }
+}
+
+/// The safe-state output of a latched fault.
+#[cold]
+#[inline(never)]
+fn trip<S>(s: &mut ControlState<S>, b: f32, i: f32, code: FaultCode) -> ControlOutput {
+    s.mode = Mode::Fault(code);
+    s.last_v = 0.0;
+    ControlOutput { b, current: i, torque_est: s.est.last, mode: s.mode, fault: code, ..Default::default() }
+}
+
+/// The slow pass's verdict: its fault, a stalled slow pass, or `None`.
+#[inline(always)]
+fn slow_verdict(k: &Coeffs, sup: &SupState) -> FaultCode {
+    if sup.since_slow <= k.slow_timeout {
+        FaultCode::None
+    } else if sup.slow_fault != FaultCode::None {
+        sup.slow_fault
+    } else {
+        FaultCode::SupervisorStalled
+    }
+}
+
+/// A running sample tripped: the code in priority order (the slow pass's verdict, its
+/// fault or a stall; the fast conditions; the slow-developing checks) and the safe-state
+/// output. One cold leaf function (no nested calls), so the trip path adds no stack frame.
+#[cold]
+#[inline(never)]
+fn tripped<S>(k: &Coeffs, s: &mut ControlState<S>, x: &ControlInput, b: f32, i: f32) -> ControlOutput {
+    let slow = slow_verdict(k, &s.sup);
+    let code = if slow != FaultCode::None {
+        slow
+    } else if s.sup.fast >= k.confirm {
+        // The model-held condition is the last in the order: no need to pass it.
+        let f = Fast { hall: x.hall, i, supply_v: x.supply_v, overrun: x.overrun, model_bad: true };
+        supervisor::fast_code_inline(k, &f)
+    } else {
+        supervisor::running_code_inline(k, &s.sup)
+    };
+    s.mode = Mode::Fault(code);
+    s.last_v = 0.0;
+    ControlOutput { b, current: i, torque_est: s.est.last, mode: s.mode, fault: code, ..Default::default() }
 }
 
 impl<M: Model> ControlStep<M> {
@@ -139,65 +230,102 @@ impl<M: Model> ControlStep<M> {
         ControlState::default()
     }
 
-    /// Process one sample. See the module documentation.
-    pub fn step(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: ControlInput) -> ControlOutput {
+    /// The slow supervisor pass, about every millisecond (at most every
+    /// [`SLOW_TIMEOUT_S`](super::config::SLOW_TIMEOUT_S)), from a task of lower priority
+    /// than the sample interrupt: checks the RAM copy of the configuration
+    /// ([`ValidatedConfig::verify`]) and that its time step is the model's, latching
+    /// [`FaultCode::ConfigCrc`] or [`FaultCode::ConfigMismatch`] for the next sample to
+    /// trip; sets the temperature compensation from `temperature` (°C, NaN: no sensor)
+    /// and the torque floor (the model's static torque at B = 0 from its present state).
+    pub fn slow(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, temperature: f32) {
         let c = cfg.get();
-        let crc_ok = s.scrub.step(cfg);
+        let dt_ok = crate::math::abs(c.dt - self.est.model.dt()) <= 1e-6 * c.dt;
+        let code = if !cfg.verify() {
+            FaultCode::ConfigCrc
+        } else if !dt_ok {
+            FaultCode::ConfigMismatch
+        } else {
+            FaultCode::None
+        };
+        if s.sup.slow_fault == FaultCode::None {
+            s.sup.slow_fault = code;
+        }
+        // First order, fluid datasheet slope.
+        let scale = if c.temp_coeff != 0.0 && temperature.is_finite() {
+            clamp(1.0 + c.temp_coeff * (temperature - c.temp_ref), 0.5, 1.5)
+        } else {
+            1.0
+        };
+        s.temp_scale = scale;
+        let (model, ms, i) = (&self.est.model, &s.est.model, s.last_i);
+        let t_static = |bb: f32| static_output(model, ms, bb, i) * scale;
+        s.t_floor = finite_or(t_static(0.0), 0.0);
+        s.ff_inv_slope = inverse_slope(t_static, s.b_star, cfg.coeffs().ff_h);
+        s.sup.since_slow = if s.sup.slow_fault == FaultCode::None { 0 } else { SLOW_LATCHED };
+        s.sup.slow_seen = true;
+    }
+
+    /// Process one sample. See the module documentation.
+    ///
+    /// A thin dispatcher: the loop-closed path and every other mode are separate functions,
+    /// so neither pays for the other's stack frame.
+    #[inline]
+    pub fn step(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: ControlInput) -> ControlOutput {
+        if s.mode == Mode::Running && x.enable {
+            self.run(cfg, s, &x)
+        } else {
+            self.other(cfg, s, &x)
+        }
+    }
+
+    /// Every mode but an enabled `Running`.
+    #[inline(never)]
+    fn other(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: &ControlInput) -> ControlOutput {
+        let (c, k) = (cfg.get(), cfg.coeffs());
+        s.sup.since_slow = s.sup.since_slow.wrapping_add(1);
         if !s.calibrated {
             s.hall_offset = c.hall_offset;
             s.current_offset = c.current_offset;
         }
-        let b = counts_to_units(x.hall, s.hall_offset, c.hall_gain);
-        let i = counts_to_units(x.current, s.current_offset, c.current_gain);
-        let mut out = ControlOutput { b, current: i, torque_est: s.est.last, ..Default::default() };
-        let dt_ok = crate::math::abs(c.dt - self.est.model.dt()) <= 1e-6 * c.dt;
-        let early = if crc_ok == Some(false) {
-            Some(FaultCode::ConfigCrc)
-        } else if !dt_ok {
-            Some(FaultCode::ConfigMismatch)
-        } else {
-            None
-        };
-        if let (Some(code), false) = (early, matches!(s.mode, Mode::Fault(_))) {
-            return self.trip(s, out, code);
+        let b = counts_to_units(x.hall, s.hall_offset, k.hall_gain);
+        let i = counts_to_units(x.current, s.current_offset, k.current_gain);
+        let out = ControlOutput { b, current: i, torque_est: s.est.last, ..Default::default() };
+        let early = slow_verdict(k, &s.sup);
+        if early != FaultCode::None && !matches!(s.mode, Mode::Fault(_)) {
+            return trip(s, b, i, early);
         }
-        match s.mode {
+        let mode = match s.mode {
             Mode::Fault(code) => {
                 if x.reset {
-                    *s = ControlState::default();
-                    out.mode = s.mode;
-                    return out;
+                    s.reset();
+                    return ControlOutput { mode: s.mode, ..out };
                 }
-                out.mode = s.mode;
-                out.fault = code;
-                return out;
+                return ControlOutput { mode: s.mode, fault: code, ..out };
             }
             Mode::Init | Mode::Disabled if !x.enable => {
-                s.mode = Mode::Disabled;
                 s.last_v = 0.0;
-                out.mode = s.mode;
-                return out;
+                Mode::Disabled
             }
+            Mode::Init | Mode::Disabled if !s.sup.slow_seen => s.mode,
             Mode::Init | Mode::Disabled => {
-                s.mode = if s.calibrated { Mode::Running } else { Mode::Calibrating };
                 s.calib = CalibState::default();
-                out.mode = s.mode;
-                return out;
+                if s.calibrated {
+                    supervisor::prime(&mut s.sup, x.hall);
+                    Mode::Running
+                } else {
+                    Mode::Calibrating
+                }
             }
             Mode::Calibrating | Mode::Running if !x.enable => {
-                s.mode = Mode::Disabled;
                 s.pi_i = PiState::default();
                 s.pi_t = PiState::default();
                 s.last_v = 0.0;
-                out.mode = s.mode;
-                return out;
+                Mode::Disabled
             }
             Mode::Calibrating => {
-                let obs =
-                    Observation { hall: x.hall, b, i, supply_v: x.supply_v, running: false, ..Default::default() };
-                let code = check(c, &mut s.sup, &obs);
-                if code != FaultCode::None {
-                    return self.trip(s, out, code);
+                let f = Fast { hall: x.hall, i, supply_v: x.supply_v, overrun: x.overrun, model_bad: false };
+                if confirm(k, &mut s.sup, fast_any(k, &f)) {
+                    return trip(s, b, i, fast_code(k, &f));
                 }
                 let cal = Calibration {
                     samples: c.calib_samples as u16,
@@ -207,124 +335,119 @@ impl<M: Model> ControlStep<M> {
                     max_offset_error: c.calib_max_offset_error,
                 };
                 match cal.step(&mut s.calib, x.hall, x.current) {
-                    CalibResult::Pending => {}
-                    CalibResult::Failed => return self.trip(s, out, FaultCode::CalibrationFailed),
+                    CalibResult::Pending => Mode::Calibrating,
+                    CalibResult::Failed => return trip(s, b, i, FaultCode::CalibrationFailed),
                     CalibResult::Done { hall_offset, current_offset } => {
                         s.hall_offset = hall_offset;
                         s.current_offset = current_offset;
                         s.calibrated = true;
-                        s.mode = Mode::Running;
+                        supervisor::prime(&mut s.sup, x.hall);
+                        Mode::Running
                     }
                 }
-                out.mode = s.mode;
-                return out;
             }
-            Mode::Running => {}
-        }
-        self.run(cfg, s, x, out, crc_ok)
+            // Not reached (`step` runs an enabled `Running` itself); bridge off if it were.
+            Mode::Running => Mode::Running,
+        };
+        s.mode = mode;
+        ControlOutput { mode, ..out }
     }
 
-    fn trip(&self, s: &mut ControlState<M::State>, mut out: ControlOutput, code: FaultCode) -> ControlOutput {
-        s.mode = Mode::Fault(code);
-        s.last_v = 0.0;
-        out.mode = s.mode;
-        out.fault = code;
-        out.duty = 0.0;
-        out.compare = 0;
-        out.pwm_enable = false;
-        out
-    }
+    /// The loop closed: estimate, supervise, feed-forward, two PIs, duty.
+    #[inline(never)]
+    fn run(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: &ControlInput) -> ControlOutput {
+        let k = cfg.coeffs();
+        s.sup.since_slow = s.sup.since_slow.wrapping_add(1);
+        // Finite by construction: u16 counts, validated gains and offsets.
+        let b = counts_to_units(x.hall, s.hall_offset, k.hall_gain);
+        let i = counts_to_units(x.current, s.current_offset, k.current_gain);
+        s.last_i = i;
+        let est = self.est.step_finite(&mut s.est, b, i);
+        let model_bad = !est.flags.ok();
 
-    fn run(
-        &self,
-        cfg: &ValidatedConfig,
-        s: &mut ControlState<M::State>,
-        x: ControlInput,
-        mut out: ControlOutput,
-        crc_ok: Option<bool>,
-    ) -> ControlOutput {
-        let c = cfg.get();
-        let (b, i) = (out.b, out.current);
-        let est = self.est.step(&mut s.est, Sample::new(b).with_command(i));
-        let obs = Observation {
-            hall: x.hall,
-            b,
-            i,
-            supply_v: x.supply_v,
-            v_applied: s.last_v,
-            model_bad: !est.flags.ok(),
-            overrun: x.overrun,
-            crc_ok,
-            running: true,
-        };
-        let code = check(c, &mut s.sup, &obs);
-        if code != FaultCode::None {
-            return self.trip(s, out, code);
+        // A supply outside its window (NaN: v_min) trips within `confirm` samples; until
+        // then the duty is computed for the nearest value inside it.
+        let supply = clamp(x.supply_v, k.v_min, k.v_max);
+        let f = Fast { hall: x.hall, i, supply_v: x.supply_v, overrun: x.overrun, model_bad };
+        let fast = confirm(k, &mut s.sup, fast_any_clamped(k, &f, supply));
+        let slow_developing = supervisor::running(k, &mut s.sup, x.hall, b, i, s.last_v);
+        let slow = s.sup.since_slow > k.slow_timeout;
+        if fast | slow | slow_developing {
+            return tripped(k, s, x, b, i);
         }
-        if !est.flags.ok() {
-            out.flags |= flags::ESTIMATE_HELD;
-        }
-        // Temperature compensation of the estimate (first order, fluid datasheet slope).
-        let scale = if c.temp_coeff != 0.0 && x.temperature.is_finite() {
-            clamp(1.0 + c.temp_coeff * (x.temperature - c.temp_ref), 0.5, 1.5)
-        } else {
-            1.0
-        };
+
+        let mut fl = if model_bad { flags::ESTIMATE_HELD } else { 0 };
+        let scale = s.temp_scale;
         let t_est = finite_or(est.y * scale, 0.0);
-        out.torque_est = t_est;
-        let lim = if c.mode == LoopMode::Current { c.i_max } else { c.torque_max };
-        let r = clamp(finite_or(x.reference, 0.0), -lim, lim);
-        if r != x.reference {
-            out.flags |= flags::REFERENCE_LIMITED;
-        }
-        let model = &self.est.model;
-        let i_ref = match c.mode {
-            LoopMode::Torque => {
-                let t_static = |bb: f32| finite_or(static_output(model, &s.est.model, bb, i) * scale, 0.0);
-                let t0 = t_static(0.0);
-                let r_eff = if r > t0 { r } else { t0 };
-                let start = clamp(finite_or(s.b_star, 0.0), 0.0, c.b_max);
-                // One Newton step per sample from the last solution: the reference moves
-                // little in one period, so this tracks the root (bounded work per sample).
-                let b_star = invert(t_static, r_eff, start, 0.0, c.b_max, 1, 1e-3 * c.b_max);
-                s.b_star = b_star;
-                let i_ff = b_star / c.b_per_amp;
-                let lead = c.ff_lead_s * (i_ff - s.i_ff) / c.dt;
-                s.i_ff = i_ff;
-                let pi = Pi::new(c.kp_t, c.ki_t, c.dt, 0.0, c.i_max);
-                pi.step(&mut s.pi_t, r_eff - t_est, clamp(i_ff + lead, 0.0, c.i_max))
+        // Reference limited; NaN → 0.
+        let (r0, lim) = (x.reference, k.ref_lim);
+        let r = if r0 >= -lim {
+            if r0 <= lim {
+                r0
+            } else {
+                lim
             }
-            LoopMode::OpenLoopTorque => StaticMap { a: c.map }.current(r, c.i_max),
+        } else if r0 < -lim {
+            -lim
+        } else {
+            0.0
+        };
+        if r != r0 {
+            fl |= flags::REFERENCE_LIMITED;
+        }
+        let i_ref = match k.mode {
+            LoopMode::Torque => {
+                let (model, ms) = (&self.est.model, &s.est.model);
+                let t_static = |bb: f32| static_output(model, ms, bb, i) * scale;
+                // Below the torque at B = 0 (from the slow pass) nothing can be reached:
+                // aim there.
+                let t0 = s.t_floor;
+                let r_eff = if t0 > r { t0 } else { r };
+                // One chord step per sample from the last solution (slope from the slow pass).
+                let b_star = chord_step(t_static, r_eff, s.b_star, s.ff_inv_slope, k.ff_hi, k.ff_step);
+                s.b_star = b_star;
+                let i_ff = b_star * k.amp_per_b;
+                let ff = clamp(i_ff + k.lead * (i_ff - s.i_ff), 0.0, k.i_max);
+                s.i_ff = i_ff;
+                step_limited(k.kp_t, k.ki_t_dt, &mut s.pi_t, r_eff - t_est, ff, 0.0, k.i_max)
+            }
+            LoopMode::OpenLoopTorque => StaticMap { a: cfg.get().map }.current(r, k.i_max),
             LoopMode::Current => r,
         };
-        let supply = finite_or(x.supply_v, 0.0);
-        let v_lim = c.duty_max * if supply > 0.0 { supply } else { 0.0 };
-        let pi_i = Pi::new(c.kp_i, c.ki_i, c.dt, -v_lim, v_lim);
-        let demag = Demag { duty: c.demag_duty, samples: c.demag_samples as u16, threshold: c.demag_threshold };
+        let v_lim = k.duty_max * supply;
+        let demag = Demag { duty: k.demag_duty, samples: k.demag_samples, threshold: k.demag_threshold };
         let (v, d) = match demag.step(&mut s.demag, r, i) {
             Some(d) => {
-                out.flags |= flags::DEMAG;
+                fl |= flags::DEMAG;
                 s.pi_i = PiState::default();
                 s.pi_t = PiState::default();
-                (d * x.supply_v, d)
+                (d * supply, d)
             }
             None => {
-                let v = pi_i.step(&mut s.pi_i, i_ref - i, c.coil_r * i_ref);
+                let v = step_limited(k.kp_i, k.ki_i_dt, &mut s.pi_i, i_ref - i, k.coil_r * i_ref, -v_lim, v_lim);
                 if crate::math::abs(v) >= v_lim {
-                    out.flags |= flags::SATURATED;
+                    fl |= flags::SATURATED;
                 }
-                (v, v / x.supply_v)
+                (v, v / supply)
             }
         };
-        let (d, compare) = duty(d * x.supply_v, x.supply_v, c.duty_max, c.pwm_counts);
-        s.last_v = finite_or(v, 0.0);
-        out.i_ref = finite_or(i_ref, 0.0);
-        out.v_cmd = s.last_v;
-        out.duty = d;
-        out.compare = compare;
-        out.pwm_enable = true;
-        out.mode = s.mode;
-        out
+        // |v| ≤ v_lim = duty_max·supply and the pulse's duty ≤ duty_max (validated): |d| ≤
+        // duty_max up to rounding, so no clamp here.
+        let (duty, compare) = quantise(d, k.pwm_counts);
+        s.last_v = v;
+        ControlOutput {
+            duty,
+            compare,
+            pwm_enable: true,
+            b,
+            current: i,
+            torque_est: t_est,
+            i_ref,
+            v_cmd: v,
+            mode: Mode::Running,
+            fault: FaultCode::None,
+            flags: fl,
+        }
     }
 }
 
@@ -345,6 +468,19 @@ mod tests {
         (step, cfg.validate().unwrap())
     }
 
+    /// A step with a slow pass every 10 samples (1 kHz at 10 kHz), as the firmware runs it.
+    fn tick<M: Model>(
+        step: &ControlStep<M>,
+        cfg: &ValidatedConfig,
+        s: &mut ControlState<M::State>,
+        x: ControlInput,
+    ) -> ControlOutput {
+        if s.sup.since_slow >= 10 || !s.sup.slow_seen {
+            step.slow(cfg, s, f32::NAN);
+        }
+        step.step(cfg, s, x)
+    }
+
     fn all_finite(o: &ControlOutput) -> bool {
         [o.duty, o.b, o.current, o.torque_est, o.i_ref, o.v_cmd].iter().all(|v| v.is_finite())
             && (-1.0..=1.0).contains(&o.duty)
@@ -355,7 +491,7 @@ mod tests {
         let (step, cfg) = setup(LoopMode::Current);
         let mut s = step.state();
         for k in 0..11u16 {
-            let o = step.step(&cfg, &mut s, ControlInput::new(2050 + k % 2, 2047, 24.0, 1.0));
+            let o = tick(&step, &cfg, &mut s, ControlInput::new(2050 + k % 2, 2047, 24.0, 1.0));
             assert!(!o.pwm_enable, "bridge stays off while calibrating");
         }
         assert_eq!(s.mode, Mode::Running);
@@ -365,7 +501,7 @@ mod tests {
         let mut i = 0.0f32;
         for k in 0..2000u16 {
             let counts = (2047.0 + i / cfg.get().current_gain).round() as u16;
-            let o = step.step(&cfg, &mut s, ControlInput::new(2050 + (i * 100.0) as u16 + k % 2, counts, 24.0, 1.0));
+            let o = tick(&step, &cfg, &mut s, ControlInput::new(2050 + (i * 100.0) as u16 + k % 2, counts, 24.0, 1.0));
             assert!(o.pwm_enable && all_finite(&o), "{o:?}");
             i += DT * (o.duty * 24.0 - r * i) / l;
         }
@@ -376,34 +512,66 @@ mod tests {
     fn fault_latches_until_reset() {
         let (step, cfg) = setup(LoopMode::Torque);
         let mut s = step.state();
-        for _ in 0..12 {
-            step.step(&cfg, &mut s, ControlInput::new(2048, 2048, 24.0, 2.0));
+        for k in 0..12 {
+            tick(&step, &cfg, &mut s, ControlInput::new(2048 + k % 2, 2048, 24.0, 2.0));
         }
-        for _ in 0..3 {
-            step.step(&cfg, &mut s, ControlInput::new(4095, 2048, 24.0, 2.0));
+        assert_eq!(s.mode, Mode::Running);
+        for _ in 0..2 {
+            let o = tick(&step, &cfg, &mut s, ControlInput::new(4095, 2048, 24.0, 2.0));
+            assert!(o.pwm_enable, "one rail sample does not trip");
         }
+        let o = tick(&step, &cfg, &mut s, ControlInput::new(4095, 2048, 24.0, 2.0));
+        assert_eq!((o.pwm_enable, o.fault, o.mode), (false, FaultCode::HallOpen, Mode::Fault(FaultCode::HallOpen)));
         assert_eq!(s.mode, Mode::Fault(FaultCode::HallOpen));
-        let o = step.step(&cfg, &mut s, ControlInput::new(2048, 2048, 24.0, 2.0));
+        let o = tick(&step, &cfg, &mut s, ControlInput::new(2048, 2048, 24.0, 2.0));
         assert_eq!((o.pwm_enable, o.duty, o.fault), (false, 0.0, FaultCode::HallOpen));
-        let o = step.step(&cfg, &mut s, ControlInput { reset: true, ..ControlInput::new(2048, 2048, 24.0, 0.0) });
+        let o = tick(&step, &cfg, &mut s, ControlInput { reset: true, ..ControlInput::new(2048, 2048, 24.0, 0.0) });
         assert_eq!(o.mode, Mode::Init);
+        assert_eq!(s, ControlState::default(), "reset is the default state");
     }
 
     #[test]
-    fn corrupted_config_trips_within_two_scrub_passes() {
+    fn the_loop_waits_for_a_slow_pass_and_trips_when_it_stalls() {
+        let (step, cfg) = setup(LoopMode::Current);
+        let mut s = step.state();
+        for k in 0..50u16 {
+            let o = step.step(&cfg, &mut s, ControlInput::new(2048 + k % 2, 2048, 24.0, 0.0));
+            assert_eq!((o.mode, o.pwm_enable), (Mode::Init, false));
+        }
+        step.slow(&cfg, &mut s, f32::NAN);
+        for k in 0..20u16 {
+            step.step(&cfg, &mut s, ControlInput::new(2048 + k % 2, 2048, 24.0, 0.0));
+        }
+        assert_eq!(s.mode, Mode::Running);
+        let timeout = cfg.coeffs().slow_timeout;
+        let mut tripped = None;
+        for k in 0..timeout {
+            let o = step.step(&cfg, &mut s, ControlInput::new(2048 + (k % 2) as u16, 2048, 24.0, 0.0));
+            if o.fault != FaultCode::None {
+                tripped = Some((k, o));
+                break;
+            }
+        }
+        let (k, o) = tripped.unwrap();
+        assert!(k + 70 >= timeout, "tripped early, after {k} samples");
+        assert_eq!((o.fault, o.pwm_enable), (FaultCode::SupervisorStalled, false));
+    }
+
+    #[test]
+    fn corrupted_config_trips_at_the_next_slow_pass() {
         // Current mode at 0 A: nothing else can trip while the coil is not simulated.
         let (step, mut cfg) = setup(LoopMode::Current);
         let mut s = step.state();
         let input = |k: u16| ControlInput::new(2048 + k % 3, 2048 + k % 2, 24.0, 0.0);
         for k in 0..20 {
-            step.step(&cfg, &mut s, input(k));
+            tick(&step, &cfg, &mut s, input(k));
         }
         assert_eq!(s.mode, Mode::Running);
         cfg.inject_bit_flip(700);
-        let passes = super::super::config::WORDS.div_ceil(super::super::config::SCRUB_WORDS);
-        let tripped =
-            (0..2 * passes).map(|k| step.step(&cfg, &mut s, input(k as u16))).any(|o| o.fault == FaultCode::ConfigCrc);
-        assert!(tripped);
+        let first =
+            (0..30u16).map(|k| tick(&step, &cfg, &mut s, input(k))).position(|o| o.fault == FaultCode::ConfigCrc);
+        assert!(first.is_some_and(|k| k <= 10), "{first:?}");
+        assert!(!tick(&step, &cfg, &mut s, input(0)).pwm_enable);
     }
 
     #[test]
@@ -411,22 +579,25 @@ mod tests {
         let (step, _) = setup(LoopMode::Torque);
         let cfg = ControlConfig { dt: 2e-4, ..ControlConfig::defaults(2e-4) }.validate().unwrap();
         let mut s = step.state();
-        let o = step.step(&cfg, &mut s, ControlInput::new(2048, 2048, 24.0, 2.0));
+        let o = tick(&step, &cfg, &mut s, ControlInput::new(2048, 2048, 24.0, 2.0));
         assert_eq!(o.fault, FaultCode::ConfigMismatch);
     }
 
-    fn any_input() -> impl Strategy<Value = ControlInput> {
+    /// A sample and, when `Some`, a slow pass with that temperature before it.
+    fn any_input() -> impl Strategy<Value = (ControlInput, Option<f32>)> {
         let f = prop_oneof![any::<f32>(), Just(f32::NAN), Just(f32::INFINITY), Just(f32::NEG_INFINITY), -30.0f32..30.0];
-        (any::<u16>(), any::<u16>(), f.clone(), f.clone(), f, any::<[bool; 3]>()).prop_map(
-            |(hall, current, supply_v, reference, temperature, [overrun, enable, reset])| ControlInput {
-                hall: hall % 4096,
-                current: current % 4096,
-                supply_v,
-                reference,
-                temperature,
-                overrun,
-                enable: enable || hall % 7 != 0,
-                reset: reset && hall % 5 == 0,
+        (any::<u16>(), any::<u16>(), f.clone(), f.clone(), f, any::<[bool; 4]>()).prop_map(
+            |(hall, current, supply_v, reference, temperature, [overrun, enable, reset, slow])| {
+                let x = ControlInput {
+                    hall: hall % 4096,
+                    current: current % 4096,
+                    supply_v,
+                    reference,
+                    overrun,
+                    enable: enable || hall % 7 != 0,
+                    reset: reset && hall % 5 == 0,
+                };
+                (x, (slow && current % 3 == 0).then_some(temperature))
             },
         )
     }
@@ -444,7 +615,10 @@ mod tests {
                 calib_max_offset_error: 4095.0, demag_samples: 5.0, ..ControlConfig::defaults(DT) }
                 .validate().unwrap();
             let mut s = step.state();
-            for x in inputs {
+            for (x, slow) in inputs {
+                if let Some(theta) = slow {
+                    step.slow(&cfg, &mut s, theta);
+                }
                 let o = step.step(&cfg, &mut s, x);
                 prop_assert!(all_finite(&o), "{:?} -> {:?}", x, o);
                 if !o.pwm_enable {

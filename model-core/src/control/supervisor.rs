@@ -3,8 +3,22 @@
 //! the safe state: PWM off, bridge high-impedance, the coil current decaying through the
 //! freewheeling diodes against the supply. An MR clutch without field transmits only its
 //! small viscous drag (the safe state of a collaborative-robot joint, seed 000 §1).
+//!
+//! Three tiers, so the per-sample cost stays small:
+//! - [`fast_any`], every sample in every active mode: the conditions that need
+//!   `confirm_samples` consecutive samples (Hall at a rail, over-current, supply outside
+//!   its window, overrun, model output held) as one combined test with one counter: any of
+//!   them on every one of `confirm` consecutive samples trips (at least as sensitive as a
+//!   counter per condition). The code, in priority order, is worked out only when it trips
+//!   ([`fast_code`]).
+//! - [`running`], every sample while the loop is closed: the slow-developing checks with
+//!   their own counters (Hall noise, stuck Hall, coil open, B inconsistent with i).
+//! - [`ControlStep::slow`](super::ControlStep::slow), about 1 kHz from a lower-priority
+//!   task: the configuration fingerprint, the model/configuration time step, the
+//!   temperature compensation. Its result is latched in [`SupState::slow_fault`]; the
+//!   per-sample step trips [`FaultCode::SupervisorStalled`] if it stops running.
 
-use super::config::ControlConfig;
+use super::config::Coeffs;
 
 /// Why the controller stopped. `code()` is the number the firmware reports.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -28,7 +42,7 @@ pub enum FaultCode {
     SupplyLow = 7,
     /// Supply above `v_max`.
     SupplyHigh = 8,
-    /// The running CRC of the configuration does not match.
+    /// The running check of the configuration (fingerprint, coefficients) failed.
     ConfigCrc = 9,
     /// The torque model produced NaN/Inf (or overflowed) on consecutive samples.
     ModelNonFinite = 10,
@@ -40,6 +54,9 @@ pub enum FaultCode {
     BImplausible = 13,
     /// The configuration's time step is not the model's.
     ConfigMismatch = 14,
+    /// The slow supervisor (configuration check) has not run for
+    /// [`SLOW_TIMEOUT_S`](super::config::SLOW_TIMEOUT_S).
+    SupervisorStalled = 15,
 }
 
 impl FaultCode {
@@ -65,159 +82,214 @@ impl FaultCode {
             Self::CalibrationFailed => "calibration_failed",
             Self::BImplausible => "b_implausible",
             Self::ConfigMismatch => "config_mismatch",
+            Self::SupervisorStalled => "supervisor_stalled",
         }
     }
-}
-
-/// What the supervisor sees each sample.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Observation {
-    pub hall: u16,
-    /// Hall flux density, T.
-    pub b: f32,
-    /// Coil current, A.
-    pub i: f32,
-    /// Supply voltage, V.
-    pub supply_v: f32,
-    /// Voltage commanded on the previous sample, V.
-    pub v_applied: f32,
-    /// The estimator held its output this sample (non-finite model output or input).
-    pub model_bad: bool,
-    /// The firmware reports the previous step missed its deadline.
-    pub overrun: bool,
-    /// Result of the running configuration CRC, when a pass ended this sample.
-    pub crc_ok: Option<bool>,
-    /// Loop running (the coil may carry current); otherwise only the sensor-independent
-    /// checks and the rails apply.
-    pub running: bool,
 }
 
 /// Counters of the checks.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SupState {
-    pub rail_hi: u16,
-    pub rail_lo: u16,
-    pub over: u16,
-    pub supply_lo: u16,
-    pub supply_hi: u16,
-    pub model: u16,
-    pub overrun: u16,
-    pub stuck: u16,
-    pub open: u16,
-    pub band: u16,
+    /// Consecutive samples with a fast condition.
+    pub fast: u32,
+    pub stuck: u32,
+    pub open: u32,
+    pub band: u32,
     /// Slew violations of the last 8 samples, one bit each, and how many are set.
     pub slew_hist: u8,
     pub slew_n: u8,
-    /// Last Hall change that exceeded the slew limit, T.
-    pub last_jump: f32,
+    /// Last Hall change that exceeded the slew limit, counts.
+    pub last_jump: i32,
     pub last_hall: u16,
-    pub last_b: f32,
-    pub primed: bool,
+    /// What the last slow pass found (`None`: all well).
+    pub slow_fault: FaultCode,
+    /// Samples since the last slow pass, or [`SLOW_LATCHED`] and up when that pass found a
+    /// fault: one compare with the timeout covers both.
+    pub since_slow: u32,
+    /// A slow pass has run since this state was reset (the loop does not start before).
+    pub slow_seen: bool,
 }
 
+/// [`SupState::since_slow`] after a slow pass that found a fault.
+pub const SLOW_LATCHED: u32 = 1 << 31;
+
+/// One sample's inputs of the fast checks.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Fast {
+    /// Hall ADC counts.
+    pub hall: u16,
+    /// Coil current, A.
+    pub i: f32,
+    /// Supply, V (any value; NaN is out of the window).
+    pub supply_v: f32,
+    /// The previous step missed its deadline.
+    pub overrun: bool,
+    /// The estimator held its output this sample.
+    pub model_bad: bool,
+}
+
+/// Whether any fast condition holds. Branch-free, NaN-proof (a NaN supply is outside
+/// the window); the current is finite by construction (counts × gain).
+#[inline(always)]
+pub fn fast_any(k: &Coeffs, f: &Fast) -> bool {
+    fast_any_clamped(k, f, super::pi::clamp(f.supply_v, k.v_min, k.v_max))
+}
+
+/// [`fast_any`] with the supply already limited to its window (`supply_in`, NaN → `v_min`),
+/// as the step computes it anyway: out of the window iff it differs from the reading.
+#[inline(always)]
+pub fn fast_any_clamped(k: &Coeffs, f: &Fast, supply_in: f32) -> bool {
+    let rail = u32::from(f.hall).wrapping_sub(k.rail_base) >= k.rail_span;
+    let over = crate::math::abs(f.i) > k.over_current;
+    let supply_bad = supply_in != f.supply_v;
+    rail | over | supply_bad | f.overrun | f.model_bad
+}
+
+/// Count a fast condition; true when it has held `confirm` consecutive samples.
+#[inline(always)]
+pub fn confirm(k: &Coeffs, s: &mut SupState, any: bool) -> bool {
+    s.fast = if any { s.fast.wrapping_add(1) } else { 0 };
+    s.fast >= k.confirm
+}
+
+/// The fault code of a sample whose fast conditions tripped, in priority order (rail
+/// high, rail low, over-current, supply low, supply high, overrun, model).
+#[cold]
+#[inline(never)]
+pub fn fast_code(k: &Coeffs, f: &Fast) -> FaultCode {
+    fast_code_inline(k, f)
+}
+
+/// [`fast_code`], inlined (for a caller that must not grow its stack).
+#[inline(always)]
+pub fn fast_code_inline(k: &Coeffs, f: &Fast) -> FaultCode {
+    let hall = u32::from(f.hall);
+    if hall >= k.rail_hi {
+        FaultCode::HallOpen
+    } else if hall.wrapping_sub(k.rail_base) >= k.rail_span {
+        FaultCode::HallShort
+    } else if crate::math::abs(f.i) > k.over_current {
+        FaultCode::OverCurrent
+    } else if f.supply_v.is_nan() || f.supply_v < k.v_min {
+        FaultCode::SupplyLow
+    } else if f.supply_v > k.v_max {
+        FaultCode::SupplyHigh
+    } else if f.overrun {
+        FaultCode::Overrun
+    } else {
+        FaultCode::ModelNonFinite
+    }
+}
+
+/// Start the slow-developing checks from this sample (on entering `Running`).
 #[inline]
-fn count(c: &mut u16, cond: bool) -> u16 {
-    *c = if cond { c.saturating_add(1) } else { 0 };
+pub fn prime(s: &mut SupState, hall: u16) {
+    s.last_hall = hall;
+    s.last_jump = 0;
+    s.slew_hist = 0;
+    s.slew_n = 0;
+    s.stuck = 0;
+    s.open = 0;
+    s.band = 0;
+}
+
+#[inline(always)]
+fn count(c: &mut u32, cond: bool) -> u32 {
+    *c = if cond { c.wrapping_add(1) } else { 0 };
     *c
 }
 
-/// Run every check; the first that trips, in a fixed priority order, is returned.
+/// The slow-developing checks of one running sample: Hall `hall` (counts) and `b` (T),
+/// coil current `i` (A), the voltage commanded on the previous sample `v_applied` (V).
+/// True when one of them trips ([`running_code`] tells which).
 #[inline(always)]
-pub fn check(cfg: &ControlConfig, s: &mut SupState, o: &Observation) -> FaultCode {
+pub fn running(k: &Coeffs, s: &mut SupState, hall: u16, b: f32, i: f32, v_applied: f32) -> bool {
     let abs = crate::math::abs;
-    let hall = f32::from(o.hall);
-    let supply_ok = o.supply_v.is_finite();
-    let c_rail_hi = hall >= cfg.hall_rail_hi;
-    let c_rail_lo = hall <= cfg.hall_rail_lo;
-    let c_supply_lo = !supply_ok || o.supply_v < cfg.v_min;
-    let c_supply_hi = supply_ok && o.supply_v > cfg.v_max;
-    let c_over = !o.i.is_finite() || abs(o.i) > cfg.over_current;
-    let c_model = o.running && o.model_bad;
     // Noise reverses direction; a real field change (even a collapse when the coil
     // opens) moves one way. A violation is a jump beyond the slew limit that reverses the
-    // previous one.
-    let db = o.b - s.last_b;
-    let big = s.primed && abs(db) > cfg.b_slew_max;
-    let slew = big && db * s.last_jump < 0.0;
+    // previous one. In counts (ΔB = Δcounts·gain): integer compares.
+    let d = i32::from(hall) - i32::from(s.last_hall);
+    s.last_hall = hall;
+    let big = d.unsigned_abs() > k.slew_counts;
+    let slew = big && d * s.last_jump < 0;
     if big {
-        s.last_jump = db;
+        s.last_jump = d;
     }
-    let new = u8::from(slew && o.running);
+    let new = u8::from(slew);
     s.slew_n = s.slew_n.wrapping_add(new).wrapping_sub(s.slew_hist >> 7);
     s.slew_hist = (s.slew_hist << 1) | new;
-    let noise = u32::from(s.slew_n) >= cfg.slew_count as u32;
-    let frozen = s.primed && o.hall == s.last_hall && o.running;
-    let c_open = o.running && abs(o.v_applied) > cfg.open_v && abs(o.i) < cfg.open_i;
-    let c_band = o.running && cfg.b_band > 0.0 && abs(o.b - cfg.b_per_amp * o.i) > cfg.b_band;
-    s.last_hall = o.hall;
-    s.last_b = o.b;
-    s.primed = true;
-    let crc_bad = o.crc_ok == Some(false);
-    let confirm = cfg.confirm_samples as u16;
-    let rail_hi = count(&mut s.rail_hi, c_rail_hi) >= confirm;
-    let rail_lo = count(&mut s.rail_lo, c_rail_lo) >= confirm;
-    let supply_lo = count(&mut s.supply_lo, c_supply_lo) >= confirm;
-    let supply_hi = count(&mut s.supply_hi, c_supply_hi) >= confirm;
-    let over = count(&mut s.over, c_over) >= confirm;
-    let model = count(&mut s.model, c_model) >= confirm;
-    let overrun = count(&mut s.overrun, o.overrun) >= confirm;
-    let stuck = cfg.stuck_samples > 0.0 && f32::from(count(&mut s.stuck, frozen)) >= cfg.stuck_samples;
-    let open = f32::from(count(&mut s.open, c_open)) >= cfg.open_samples;
-    let band = f32::from(count(&mut s.band, c_band)) >= cfg.band_samples;
-    if crc_bad {
-        FaultCode::ConfigCrc
-    } else if rail_hi {
-        FaultCode::HallOpen
-    } else if rail_lo {
-        FaultCode::HallShort
-    } else if over {
-        FaultCode::OverCurrent
-    } else if supply_lo {
-        FaultCode::SupplyLow
-    } else if supply_hi {
-        FaultCode::SupplyHigh
-    } else if overrun {
-        FaultCode::Overrun
-    } else if model {
-        FaultCode::ModelNonFinite
-    } else if noise {
+    let noise = u32::from(s.slew_n) >= k.slew_n;
+    let stuck = count(&mut s.stuck, d == 0) >= k.stuck_n;
+    let open = count(&mut s.open, abs(v_applied) > k.open_v && abs(i) < k.open_i) >= k.open_n;
+    let band = count(&mut s.band, abs(b - k.b_per_amp * i) > k.b_band) >= k.band_n;
+    noise | stuck | open | band
+}
+
+/// Which slow-developing check tripped (after [`running`] returned true), in priority
+/// order: noise, stuck, coil open, band.
+#[cold]
+#[inline(never)]
+pub fn running_code(k: &Coeffs, s: &SupState) -> FaultCode {
+    running_code_inline(k, s)
+}
+
+/// [`running_code`], inlined (for a caller that must not grow its stack).
+#[inline(always)]
+pub fn running_code_inline(k: &Coeffs, s: &SupState) -> FaultCode {
+    if u32::from(s.slew_n) >= k.slew_n {
         FaultCode::HallNoise
-    } else if stuck {
+    } else if s.stuck >= k.stuck_n {
         FaultCode::HallStuck
-    } else if open {
+    } else if s.open >= k.open_n {
         FaultCode::CoilOpen
-    } else if band {
-        FaultCode::BImplausible
     } else {
-        FaultCode::None
+        FaultCode::BImplausible
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::control::ControlConfig;
 
-    fn ok_obs(k: u16) -> Observation {
-        Observation {
-            hall: 2048 + k % 3,
-            b: 0.1,
-            i: 0.5,
-            supply_v: 24.0,
-            v_applied: 2.0,
-            running: true,
-            ..Default::default()
+    #[derive(Clone, Copy)]
+    struct Obs {
+        hall: u16,
+        b: f32,
+        i: f32,
+        supply_v: f32,
+        v_applied: f32,
+        model_bad: bool,
+        overrun: bool,
+    }
+
+    fn ok_obs(k: u16) -> Obs {
+        Obs { hall: 2048 + k % 3, b: 0.1, i: 0.5, supply_v: 24.0, v_applied: 2.0, model_bad: false, overrun: false }
+    }
+
+    fn check(k: &Coeffs, s: &mut SupState, o: &Obs) -> FaultCode {
+        let f = Fast { hall: o.hall, i: o.i, supply_v: o.supply_v, overrun: o.overrun, model_bad: o.model_bad };
+        if confirm(k, s, fast_any(k, &f)) {
+            return fast_code(k, &f);
+        }
+        if running(k, s, o.hall, o.b, o.i, o.v_applied) {
+            running_code(k, s)
+        } else {
+            FaultCode::None
         }
     }
 
-    fn run(cfg: &ControlConfig, f: impl Fn(u16) -> Observation) -> (FaultCode, u16) {
+    fn run(cfg: &ControlConfig, f: impl Fn(u16) -> Obs) -> (FaultCode, u16) {
+        let k = Coeffs::new(cfg);
         let mut s = SupState::default();
-        for k in 0..50u16 {
-            check(cfg, &mut s, &ok_obs(k));
+        prime(&mut s, 2047);
+        for k0 in 0..50u16 {
+            assert_eq!(check(&k, &mut s, &ok_obs(k0)), FaultCode::None);
         }
-        for k in 0..100u16 {
-            let c = check(cfg, &mut s, &f(k));
+        for k0 in 0..100u16 {
+            let c = check(&k, &mut s, &f(k0));
             if c != FaultCode::None {
-                return (c, k + 1);
+                return (c, k0 + 1);
             }
         }
         (FaultCode::None, 0)
@@ -227,23 +299,47 @@ mod tests {
     fn each_check_trips_alone_and_healthy_does_not() {
         let cfg = ControlConfig::defaults(1e-4);
         assert_eq!(run(&cfg, ok_obs).0, FaultCode::None);
-        assert_eq!(run(&cfg, |k| Observation { hall: 4095, ..ok_obs(k) }), (FaultCode::HallOpen, 3));
-        assert_eq!(run(&cfg, |k| Observation { hall: 0, ..ok_obs(k) }), (FaultCode::HallShort, 3));
-        assert_eq!(run(&cfg, |k| Observation { hall: 2100, ..ok_obs(k) }), (FaultCode::HallStuck, 13));
-        let noisy = |k: u16| Observation { b: if k.is_multiple_of(2) { 0.3 } else { -0.2 }, ..ok_obs(k) };
+        assert_eq!(run(&cfg, |k| Obs { hall: 4095, ..ok_obs(k) }), (FaultCode::HallOpen, 3));
+        assert_eq!(run(&cfg, |k| Obs { hall: 4079, ..ok_obs(k) }), (FaultCode::HallOpen, 3));
+        assert_eq!(run(&cfg, |k| Obs { hall: 0, ..ok_obs(k) }), (FaultCode::HallShort, 3));
+        assert_eq!(run(&cfg, |k| Obs { hall: 16, ..ok_obs(k) }), (FaultCode::HallShort, 3));
+        assert_eq!(run(&cfg, |k| Obs { hall: 4078 - k % 2, ..ok_obs(k) }).0, FaultCode::None);
+        assert_eq!(run(&cfg, |k| Obs { hall: 17 + k % 2, ..ok_obs(k) }).0, FaultCode::None);
+        assert_eq!(run(&cfg, |k| Obs { hall: 2100, ..ok_obs(k) }), (FaultCode::HallStuck, 13));
+        // 0.02 T per sample at 1.25/2048 T per count: 32.8 counts.
+        let noisy = |k: u16| Obs { hall: if k.is_multiple_of(2) { 2100 } else { 2000 }, ..ok_obs(k) };
         // The first jump has no earlier one to reverse: the third reversal is the 4th sample.
         assert_eq!(run(&cfg, noisy), (FaultCode::HallNoise, 4));
         // A one-way collapse of the field (coil opened) is not noise.
-        let collapse = |k: u16| Observation { b: 0.1 - 0.05 * f32::from(k.min(2)), ..ok_obs(k) };
+        let collapse = |k: u16| Obs { hall: 2048 - 60 * k.min(2) + k % 3, ..ok_obs(k) };
         assert_eq!(run(&cfg, collapse).0, FaultCode::None);
-        assert_eq!(run(&cfg, |k| Observation { i: 0.0, v_applied: 10.0, ..ok_obs(k) }), (FaultCode::CoilOpen, 10));
-        assert_eq!(run(&cfg, |k| Observation { i: 9.0, ..ok_obs(k) }), (FaultCode::OverCurrent, 3));
-        assert_eq!(run(&cfg, |k| Observation { supply_v: 12.0, ..ok_obs(k) }), (FaultCode::SupplyLow, 3));
-        assert_eq!(run(&cfg, |k| Observation { overrun: true, ..ok_obs(k) }), (FaultCode::Overrun, 3));
-        assert_eq!(run(&cfg, |k| Observation { model_bad: true, ..ok_obs(k) }), (FaultCode::ModelNonFinite, 3));
-        assert_eq!(run(&cfg, |k| Observation { crc_ok: Some(false), ..ok_obs(k) }), (FaultCode::ConfigCrc, 1));
+        // Jumps just within the slew limit, reversing every sample, are not noise.
+        let wobble = |k: u16| Obs { hall: if k.is_multiple_of(2) { 2080 } else { 2048 }, ..ok_obs(k) };
+        assert_eq!(run(&cfg, wobble).0, FaultCode::None);
+        let rattle = |k: u16| Obs { hall: if k.is_multiple_of(2) { 2081 } else { 2048 }, ..ok_obs(k) };
+        assert_eq!(run(&cfg, rattle).0, FaultCode::HallNoise);
+        assert_eq!(run(&cfg, |k| Obs { i: 0.0, v_applied: 10.0, ..ok_obs(k) }), (FaultCode::CoilOpen, 10));
+        assert_eq!(run(&cfg, |k| Obs { i: 9.0, ..ok_obs(k) }), (FaultCode::OverCurrent, 3));
+        assert_eq!(run(&cfg, |k| Obs { i: -9.0, ..ok_obs(k) }), (FaultCode::OverCurrent, 3));
+        assert_eq!(run(&cfg, |k| Obs { supply_v: 12.0, ..ok_obs(k) }), (FaultCode::SupplyLow, 3));
+        assert_eq!(run(&cfg, |k| Obs { supply_v: f32::NAN, ..ok_obs(k) }), (FaultCode::SupplyLow, 3));
+        assert_eq!(run(&cfg, |k| Obs { supply_v: 40.0, ..ok_obs(k) }), (FaultCode::SupplyHigh, 3));
+        assert_eq!(run(&cfg, |k| Obs { supply_v: f32::INFINITY, ..ok_obs(k) }), (FaultCode::SupplyHigh, 3));
+        assert_eq!(run(&cfg, |k| Obs { overrun: true, ..ok_obs(k) }), (FaultCode::Overrun, 3));
+        assert_eq!(run(&cfg, |k| Obs { model_bad: true, ..ok_obs(k) }), (FaultCode::ModelNonFinite, 3));
+        // Conditions that alternate still trip (one counter for all): the code is the
+        // priority of the sample that confirms.
+        let alt =
+            |k: u16| if k.is_multiple_of(2) { Obs { overrun: true, ..ok_obs(k) } } else { Obs { i: 9.0, ..ok_obs(k) } };
+        assert_eq!(run(&cfg, alt), (FaultCode::Overrun, 3));
+        // One bad sample in between resets the count.
+        let gap = |k: u16| if k % 3 == 2 { ok_obs(k) } else { Obs { i: 9.0, ..ok_obs(k) } };
+        assert_eq!(run(&cfg, gap).0, FaultCode::None);
         let banded = ControlConfig { b_band: 0.05, ..cfg };
-        assert_eq!(run(&banded, |k| Observation { b: 0.5, ..ok_obs(k) }), (FaultCode::BImplausible, 10));
-        assert_eq!(run(&banded, |k| Observation { i: 2.0, ..ok_obs(k) }), (FaultCode::BImplausible, 10));
+        assert_eq!(run(&banded, |k| Obs { b: 0.5, ..ok_obs(k) }), (FaultCode::BImplausible, 10));
+        assert_eq!(run(&banded, |k| Obs { i: 2.0, ..ok_obs(k) }), (FaultCode::BImplausible, 10));
+        // Disabled checks never trip.
+        let off = ControlConfig { stuck_samples: 0.0, ..cfg };
+        assert_eq!(run(&off, |k| Obs { hall: 2100, ..ok_obs(k) }).0, FaultCode::None);
     }
 }
