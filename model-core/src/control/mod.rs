@@ -7,6 +7,9 @@
 //! PI → H-bridge duty with the demagnetising pulse ([`pwm`]). The [`supervisor`] checks every
 //! sample for implausible readings and latches a fault code; any fault ends in the safe
 //! state (PWM off, bridge high-impedance so the coil de-energises through the diodes).
+//! What need not run every sample runs in [`step::ControlStep::slow`] (about 1 kHz): the
+//! configuration check, the time-step check, the temperature compensation and the
+//! feed-forward's slope; the per-sample step trips if that pass stalls.
 //! Settings are a [`config::ValidatedConfig`]: validated once, CRC-protected, swapped in
 //! between samples by replacing a `Copy` value. The flash page that holds the model, its
 //! parameters and these settings is [`page`].
