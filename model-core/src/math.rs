@@ -131,6 +131,22 @@ pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
     }
 }
 
+/// `x` limited to `[−lim, lim]` (`lim ≥ 0`), NaN → 0: compares only, no libm.
+#[inline(always)]
+pub fn clamp_symmetric(x: f32, lim: f32) -> f32 {
+    if x >= -lim {
+        if x <= lim {
+            x
+        } else {
+            lim
+        }
+    } else if x < -lim {
+        -lim
+    } else {
+        0.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -177,5 +193,14 @@ mod tests {
         assert!(expm1_small(f32::NAN).is_nan() && tanh_small(f32::NAN).is_nan());
         assert_eq!(tanh_small(0.0), 0.0);
         assert_eq!((tanh_small(20.0), tanh_small(-20.0)), (1.0, -1.0));
+    }
+
+    #[test]
+    fn symmetric_clamp_limits_and_zeroes_nan() {
+        assert_eq!(clamp_symmetric(0.5, 1.0), 0.5);
+        assert_eq!(clamp_symmetric(3.0, 1.0), 1.0);
+        assert_eq!(clamp_symmetric(-3.0, 1.0), -1.0);
+        assert_eq!(clamp_symmetric(f32::NAN, 1.0), 0.0);
+        assert_eq!(clamp_symmetric(f32::NEG_INFINITY, 2.0), -2.0);
     }
 }

@@ -57,17 +57,7 @@ pub fn inverse_slope<F: Fn(f32) -> f32>(f: F, x: f32, h: f32) -> f32 {
 pub fn chord_step<F: Fn(f32) -> f32>(f: F, target: f32, x: f32, inv_slope: f32, hi: f32, max_step: f32) -> f32 {
     let q = (target - f(x)) * inv_slope;
     // NaN → no step.
-    let dx = if q >= -max_step {
-        if q <= max_step {
-            q
-        } else {
-            max_step
-        }
-    } else if q < -max_step {
-        -max_step
-    } else {
-        0.0
-    };
+    let dx = crate::math::clamp_symmetric(q, max_step);
     clamp(x + dx, 0.0, hi)
 }
 
