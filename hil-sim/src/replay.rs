@@ -80,6 +80,19 @@ pub fn replay_recording(
 }
 
 /// The samples the core sees: input `x` in f32, with the command `u` when there is one.
+/// [`samples`] with a given rate and acceleration of the input attached (the core then uses
+/// them instead of its rate estimator's).
+pub fn samples_with_rates(x: &[f64], u: Option<&[f64]>, rates: Option<&(Vec<f64>, Vec<f64>)>) -> Vec<Sample> {
+    let mut s = samples(x, u);
+    if let Some((dx, ddx)) = rates {
+        for ((s, d), dd) in s.iter_mut().zip(dx).zip(ddx) {
+            s.dx = Some(*d as f32);
+            s.ddx = Some(*dd as f32);
+        }
+    }
+    s
+}
+
 pub fn samples(x: &[f64], u: Option<&[f64]>) -> Vec<Sample> {
     x.iter()
         .enumerate()

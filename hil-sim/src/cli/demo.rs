@@ -174,7 +174,35 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         100.0 * tb.r_rmse
     );
 
-    // 4. The fixed-step core against f64 references (short runs).
+    // 4. A diagnosis: the damper file through a model that ignores the command voltage.
+    eprintln!("diagnosing ranran_50.csv from bouc_wen without the command channel");
+    let diag_args = super::diagnose::DiagnoseArgs {
+        rec: hil_sim::data::data_file("dyke/ranran_50.csv").map_err(anyhow::Error::msg)?,
+        model: "bouc_wen".into(),
+        heldout: 0.3,
+        ch: super::ChannelArgs {
+            time: "t".into(),
+            input: "D".into(),
+            output: "F".into(),
+            command: None,
+            rate: "auto".into(),
+            keep_flagged: false,
+        },
+        max_findings: 3,
+        seed: 1,
+        out: None,
+        json: false,
+    };
+    let (diag, _) = super::diagnose::run_diagnosis(&diag_args)?;
+    rep.heading("Diagnosis: what Bouc–Wen misses on ranran_50.csv (`hil-sim diagnose --model bouc_wen`)");
+    rep.paragraph(
+        "The classical Bouc–Wen model has no command input, so it cannot know that the damper's force follows the \
+         command voltage Y. `diagnose` is given D and F only; Y and A are auxiliary channels it may use.",
+    );
+    hil_sim::diagnose::report::section(&mut rep, &a.out, "diagnose_ranran50", &diag, ("D", "F"))?;
+    text += &format!("\ndiagnosis of ranran_50.csv from bouc_wen (no --command):\n{}", super::diagnose::text(&diag));
+
+    // 5. The fixed-step core against f64 references (short runs).
     let acc = super::accuracy::rows(&super::accuracy::AccuracyArgs {
         model: None,
         quick: true,
@@ -199,6 +227,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
             "fits": fits_json,
             "published_spencer": replays,
             "loop": {"tracking": tl, "baseline": tb},
+            "diagnosis": diag,
             "accuracy": {"runs": acc.len(), "worst_r_rmse": worst},
             "report": index,
         }));

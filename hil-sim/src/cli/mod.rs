@@ -5,6 +5,7 @@ mod accuracy;
 mod budget;
 mod compare;
 mod demo;
+mod diagnose;
 mod export;
 mod fit;
 mod loop_cmd;
@@ -40,6 +41,8 @@ pub enum Cmd {
     Accuracy(accuracy::AccuracyArgs),
     /// The main job on the bundled data (see README).
     Demo(demo::DemoArgs),
+    /// Find the physics a model misses (shared/spec/physics-catalog.md), refit, and prove it held out.
+    Diagnose(diagnose::DiagnoseArgs),
     /// Write a recording of the simulated MR clutch (`t,b,torque,i,…`).
     Simulate(simulate::SimulateArgs),
     /// Closed loop: the firmware's control step against the simulated clutch.
@@ -58,6 +61,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Cmd::Compare(a) => compare::run(a),
         Cmd::Accuracy(a) => accuracy::run(a),
         Cmd::Demo(a) => demo::run(a),
+        Cmd::Diagnose(a) => diagnose::run(a),
         Cmd::Simulate(a) => simulate::run_cmd(a),
         Cmd::Loop(a) => loop_cmd::run_cmd(a),
         Cmd::Budget(a) => budget::run(a),

@@ -2,14 +2,44 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
+use hil_sim::concealed::{generate, ConcealedSpec};
 use hil_sim::scenario::{Quantity, Scenario, BUILTIN};
 use serde_json::json;
 
 #[derive(Args, Debug)]
+#[command(group(clap::ArgGroup::new("what").required(true).args(["scenario", "effect"])))]
 pub struct SimulateArgs {
-    /// Built-in scenario name or a TOML scenario file.
+    /// Built-in scenario name or a TOML scenario file (the simulated clutch in closed loop).
     #[arg(long)]
-    pub scenario: String,
+    pub scenario: Option<String>,
+    /// Instead of a scenario: a recording with one concealed catalog effect (or `none`), for
+    /// proving `diagnose` blind: none, field_lag, transport_delay, saturation,
+    /// rate_dependence, asymmetry, thermal_drift, slip_speed, inertia, aux_dependence,
+    /// sensor_offset. Columns `t,b,torque,i,speed,temperature`.
+    #[arg(long)]
+    pub effect: Option<String>,
+    /// With --effect: the truth's model (algebraic, bouc_wen, lugre, tanh, dahl).
+    #[arg(long, default_value = "bouc_wen", requires = "effect")]
+    pub base: String,
+    /// With --effect: the field excitation (multisine, noise, sweep, triangle).
+    #[arg(long, default_value = "multisine", requires = "effect")]
+    pub excitation: String,
+    /// With --effect: RMS of the effect's change to the torque, fraction of its span.
+    #[arg(long, default_value_t = 0.04, requires = "effect")]
+    pub size: f64,
+    /// With --effect: random seed (phases, noise).
+    #[arg(long, default_value_t = 1, requires = "effect")]
+    pub seed: u64,
+    /// With --effect: length, seconds.
+    #[arg(long, default_value_t = 30.0, requires = "effect")]
+    pub duration: f64,
+    /// With --effect: sampling rate, Hz.
+    #[arg(long, default_value_t = 2000.0, requires = "effect")]
+    pub fs: f64,
+    /// With --effect: write what was concealed (effect, true values) to this JSON file; the
+    /// recording itself never says.
+    #[arg(long, requires = "effect")]
+    pub label: Option<PathBuf>,
     /// CSV recording to write (`t,b,torque,i,…`).
     #[arg(long)]
     pub out: PathBuf,
@@ -17,8 +47,57 @@ pub struct SimulateArgs {
     pub json: bool,
 }
 
+fn write(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}
+
+fn run_concealed(a: &SimulateArgs, effect: &str) -> anyhow::Result<()> {
+    let spec = ConcealedSpec {
+        effect: effect.to_owned(),
+        base: a.base.clone(),
+        excitation: a.excitation.clone(),
+        size: a.size,
+        seed: a.seed,
+        duration_s: a.duration,
+        fs_hz: a.fs,
+    };
+    let pb = super::progress(1, "generating");
+    let g = generate(&spec)?;
+    pb.finish_and_clear();
+    write(&a.out, &g.csv)?;
+    if let Some(l) = &a.label {
+        write(l, &(serde_json::to_string_pretty(&g.label)? + "\n"))?;
+    }
+    let rows = (a.duration * a.fs).round() as usize;
+    if a.json {
+        return super::print_json(&json!({
+            "out": a.out, "rows": rows, "fs_hz": a.fs, "label_file": a.label,
+            "columns": ["t", "b", "torque", "i", "speed", "temperature"],
+            "torque_span_nm": g.label.torque_span_nm,
+        }));
+    }
+    super::emit(&format!(
+        "{} rows at {} Hz ({} base, {} excitation) -> {}{}\n",
+        rows,
+        a.fs,
+        a.base,
+        a.excitation,
+        a.out.display(),
+        a.label.as_ref().map(|l| format!("; label in {}", l.display())).unwrap_or_default()
+    ));
+    Ok(())
+}
+
 pub fn run_cmd(a: SimulateArgs) -> anyhow::Result<()> {
-    let sc = Scenario::load(&a.scenario)?;
+    let name = match (&a.scenario, &a.effect) {
+        (_, Some(effect)) => return run_concealed(&a, effect),
+        (Some(s), None) => s.clone(),
+        (None, None) => anyhow::bail!("give --scenario NAME or --effect EFFECT"),
+    };
+    let sc = Scenario::load(&name)?;
     if sc.reference.quantity != Quantity::Current {
         anyhow::bail!(
             "scenario `{}`: simulate drives the coil current; a torque reference needs `hil-sim loop` (built-in: {})",

@@ -79,6 +79,9 @@ pub struct Dataset {
     /// Samples the quality checks flagged: excluded from the fit (the model still runs
     /// through them) and scored separately.
     pub excluded: Vec<bool>,
+    /// Given rate and acceleration of the input (e.g. [`crate::rate_offline::rates`]): fed to
+    /// the models instead of the rate estimator's when present.
+    pub rates: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl Dataset {
@@ -99,7 +102,7 @@ impl Dataset {
             return Err(FitError::NoHeldOut);
         }
         let excluded = excluded.filter(|e| e.len() == n).unwrap_or_else(|| vec![false; n]);
-        let d = Self { dt, time, input, output, command, train_end, excluded };
+        let d = Self { dt, time, input, output, command, train_end, excluded, rates: None };
         let usable = d.train_rows().len();
         if usable < 20 {
             return Err(FitError::TooFewSamples(usable));
@@ -114,9 +117,10 @@ impl Dataset {
         self.input.is_empty()
     }
 
-    /// The samples as the core sees them (f32, with the command when there is one).
+    /// The samples as the core sees them (f32, with the command when there is one, and the
+    /// given rates when there are some).
     pub fn samples(&self) -> Vec<Sample> {
-        crate::replay::samples(&self.input, self.command.as_deref())
+        crate::replay::samples_with_rates(&self.input, self.command.as_deref(), self.rates.as_ref())
     }
 
     /// Training samples that enter the fit.
@@ -318,8 +322,15 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     let p32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
     // The channels as the model saw them (as recorded when no delay was fitted).
     let (input, command) = crate::alignment::shift_channels(&data.input, data.command.as_deref(), delay, delay_u);
-    let samples =
-        if delay == 0.0 && delay_u == 0.0 { samples } else { crate::replay::samples(&input, command.as_deref()) };
+    let samples = if delay == 0.0 && delay_u == 0.0 {
+        samples
+    } else {
+        let rates = data
+            .rates
+            .as_ref()
+            .map(|(dx, ddx)| (crate::alignment::shift(dx, delay), crate::alignment::shift(ddx, delay)));
+        crate::replay::samples_with_rates(&input, command.as_deref(), rates.as_ref())
+    };
     let t0 = Instant::now();
     let rep = replay(id, &p32, dt, sp.rate, &samples)
         .map_err(|e| FitError::Replay { model: id.to_owned(), reason: e.to_string() })?;
@@ -613,6 +624,7 @@ mod tests {
             command: u,
             train_end: 4200,
             excluded: vec![false; n],
+            rates: None,
         }
     }
 

@@ -1,0 +1,121 @@
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+use hil_sim::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
+use hil_sim::fit::Dataset;
+use hil_sim::quality;
+use hil_sim::recording::Recording;
+
+use super::ChannelArgs;
+
+#[derive(Args, Debug)]
+pub struct DiagnoseArgs {
+    /// Recording (CSV or MAT).
+    pub rec: PathBuf,
+    /// Base model id, or `auto` (every seed model; the best held-out one is the base).
+    #[arg(long, default_value = "auto")]
+    pub model: String,
+    /// Fraction of the recording held out (its end): the refits never see it.
+    #[arg(long, default_value_t = 0.3)]
+    pub heldout: f64,
+    #[command(flatten)]
+    pub ch: ChannelArgs,
+    /// Most findings (rounds of naming and refitting).
+    #[arg(long, default_value_t = 3)]
+    pub max_findings: usize,
+    /// Seed of the base model's global search.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Write a report (report.md, index.html and SVG plots) to this folder.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Read, check and diagnose a recording; shared with the demo.
+pub fn run_diagnosis(a: &DiagnoseArgs) -> anyhow::Result<(Diagnosis, Dataset)> {
+    if !(0.05..=0.8).contains(&a.heldout) {
+        anyhow::bail!("--heldout {}: must be between 0.05 and 0.8", a.heldout);
+    }
+    if a.model != "auto" {
+        super::fit::model_list(&a.model)?;
+        if a.model.contains(',') {
+            anyhow::bail!("--model {}: one base model (or `auto`)", a.model);
+        }
+    }
+    let path = super::file_arg(&a.rec)?;
+    let rec = Recording::read(&path)?;
+    let ch = a.ch.channels();
+    let q = quality::check(&rec, &ch)?;
+    for w in &q.warnings {
+        eprintln!("warning: {}", w.message);
+    }
+    let excluded = (!a.ch.keep_flagged).then(|| q.excluded());
+    let data = Dataset::new(&rec, &ch, 1.0 - a.heldout, excluded).with_context(|| format!("{}", path.display()))?;
+    let aux: Vec<(String, Vec<f64>)> = rec
+        .auxiliary(&ch)
+        .into_iter()
+        .filter_map(|n| rec.channel(n).ok().map(|v| (n.to_owned(), v.to_vec())))
+        .collect();
+    let opts = DiagnoseOptions {
+        model: (a.model != "auto").then(|| a.model.clone()),
+        heldout: a.heldout,
+        rate: a.ch.rate()?,
+        seed: a.seed,
+        max_findings: a.max_findings,
+    };
+    let pb = super::progress(1, "diagnosing");
+    let d = diagnose(&data, aux, ch.command.as_deref(), (&ch.input, &ch.output), &opts, &pb)
+        .with_context(|| format!("diagnosing {}", path.display()))?;
+    Ok((d, data))
+}
+
+pub fn run(a: DiagnoseArgs) -> anyhow::Result<()> {
+    let (d, _) = run_diagnosis(&a)?;
+    if let Some(dir) = &a.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        let mut rep = hil_sim::report::Report::new(format!("Diagnosis of {}", a.rec.display()));
+        hil_sim::diagnose::report::section(&mut rep, dir, "diagnose", &d, (&a.ch.input, &a.ch.output))?;
+        let index = rep.write(dir)?;
+        eprintln!("report written to {}", index.display());
+    }
+    if a.json {
+        return super::print_json(&serde_json::to_value(&d)?);
+    }
+    super::emit(&text(&d));
+    Ok(())
+}
+
+/// The diagnosis in words.
+pub fn text(d: &Diagnosis) -> String {
+    let mut s = format!(
+        "base model {}: held-out R-RMSE {:.2} %, R² {:.4} (residual noise floor {:.4})\n",
+        d.base_model,
+        100.0 * d.base_heldout.r_rmse,
+        d.base_heldout.r2,
+        d.locate.noise_rms
+    );
+    if d.findings.is_empty() {
+        s += "no finding: nothing in the catalog lowers the held-out error by more than chance\n";
+    }
+    for (k, f) in d.findings.iter().enumerate() {
+        s += &format!("{}. {}: {}\n", k + 1, f.effect, f.summary);
+        if !f.windows.is_empty() {
+            let w: Vec<String> = f.windows.iter().map(|(a, b)| format!("{a:.2}-{b:.2} s")).collect();
+            s += &format!("   where: {}", w.join(", "));
+            if let Some(c) = f.conditions.first() {
+                s += &format!("; mostly at {} {} ({:.1}x its share of samples)", c.variable, c.bin, c.concentration);
+            }
+            s += "\n";
+        }
+    }
+    s += &format!(
+        "final: held-out R-RMSE {:.2} %, R² {:.4}; {:.1} s\n",
+        100.0 * d.final_heldout.r_rmse,
+        d.final_heldout.r2,
+        d.seconds
+    );
+    s
+}
