@@ -1,7 +1,8 @@
 //! Recordings with one concealed effect of the missing-physics catalog
 //! (shared/spec/physics-catalog.md), for proving `hil-sim diagnose` blind.
 //!
-//! **Truth.** The field `b_true(t)` (T, 0.05–0.6 T) follows one of [`EXCITATIONS`]; the torque
+//! **Truth.** The field `b_true(t)` (T, 0.05–0.6 T; ±0.5 T for `bipolar`) follows one of
+//! [`EXCITATIONS`]; the torque
 //! is one of model-core's models ([`BASES`], a clutch-like parameter set fitted once on
 //! `hil-sim simulate --scenario multisine`, see [`truth`]) driven by `b_true` and its true
 //! (zero-phase) rate. Every recording carries the same auxiliary channels, effect or not:
@@ -63,7 +64,7 @@ pub const EFFECTS: &[&str] = &[
 /// Base models of the truth.
 pub const BASES: &[&str] = &["algebraic", "bouc_wen", "lugre", "tanh", "dahl"];
 /// Field excitations.
-pub const EXCITATIONS: &[&str] = &["multisine", "noise", "sweep", "triangle"];
+pub const EXCITATIONS: &[&str] = &["multisine", "noise", "sweep", "triangle", "bipolar"];
 
 /// Eddy-current time constant between coil current and field, s.
 const TAU_EDDY_S: f64 = 0.002;
@@ -191,7 +192,7 @@ fn flat(base: &str) -> Option<Vec<f32>> {
 /// The excitation, normalised to [−1, 1].
 fn excitation(name: &str, t: &[f64], duration: f64, rng: &mut impl Rng) -> Vec<f64> {
     let raw: Vec<f64> = match name {
-        "multisine" => {
+        "multisine" | "bipolar" => {
             let f = [0.7, 1.3, 2.9, 4.1, 6.7, 9.3];
             let ph: Vec<f64> = f.iter().map(|_| 2.0 * PI * rng.random::<f64>()).collect();
             t.iter().map(|t| f.iter().zip(&ph).map(|(f, p)| (2.0 * PI * f * t + p).sin()).sum()).collect()
@@ -287,7 +288,10 @@ pub fn generate(spec: &ConcealedSpec) -> Result<Concealed, ConcealedError> {
     let mut rng = rand::rngs::StdRng::seed_from_u64(spec.seed);
     let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
     let s = excitation(&spec.excitation, &t, spec.duration_s, &mut rng);
-    let b: Vec<f64> = s.iter().map(|s| 0.325 + 0.275 * s).collect();
+    // `bipolar`: the multi-sine through zero (an H-bridge driving the coil both ways), where
+    // a zero offset of the Hall reading shows as a kink away from zero.
+    let b: Vec<f64> =
+        s.iter().map(|s| if spec.excitation == "bipolar" { 0.5 * s } else { 0.325 + 0.275 * s }).collect();
     let (db, _) = crate::rate_offline::rates(&b, dt);
     let db_std = rms(&db.iter().map(|v| v - db.iter().sum::<f64>() / n as f64).collect::<Vec<_>>()).max(1e-12);
     let b_max = b.iter().fold(0.0f64, |a, v| a.max(*v));
