@@ -156,14 +156,6 @@ impl SampleLog {
         }
     }
 
-    /// Clear in place (no log-sized temporary).
-    #[inline]
-    pub fn clear(&mut self) {
-        for e in self.0.iter_mut() {
-            *e = LogEntry::default();
-        }
-    }
-
     /// Replay the entries after `start` up to `end` (positions as [`record`](Self::record)
     /// got them; at most the last [`LOG_SAMPLES`]) through [`running`], converting the
     /// counts with the offsets (counts) and the gains of `k`. Returns the first fault found
