@@ -13,8 +13,12 @@
 //!   equally bounded path.
 //! - [`ControlStep::slow`], about 1 kHz from a lower-priority task: the checks that need
 //!   not run every sample (configuration fingerprint and coefficients, model/configuration
-//!   time step) and the temperature compensation. A fault it finds is latched and trips
-//!   the next sample; a step that sees no slow pass for
+//!   time step, and the slow-developing supervisor checks — Hall noise, stuck Hall, coil
+//!   open, B/i band — replayed from the [`SampleLog`] the step writes, a few instructions
+//!   a sample) and the temperature compensation. A fault it finds is latched and trips
+//!   the next sample, so a slow-developing fault trips within its own sample count plus
+//!   one slow period plus one sample (at 20 kHz with the 1 kHz pass: ≤ 21 samples later
+//!   than when it was judged every sample); a step that sees no slow pass for
 //!   [`SLOW_TIMEOUT_S`](super::config::SLOW_TIMEOUT_S) trips
 //!   [`FaultCode::SupervisorStalled`], and the loop does not start before a first pass.
 
