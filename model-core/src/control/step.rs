@@ -617,7 +617,8 @@ mod tests {
                     break;
                 }
             }
-            let (n, o, slow_before) = tripped.unwrap_or_else(|| panic!("{code:?} did not trip"));
+            assert!(tripped.is_some(), "{code:?} did not trip");
+            let (n, o, slow_before) = tripped.unwrap();
             assert_eq!((o.fault, o.pwm_enable, o.mode), (code, false, Mode::Fault(code)));
             assert!(slow_before, "{code:?}: tripped on a sample without a slow pass before it");
             assert!(n >= count.min(4) && n <= count + 10 + 1, "{code:?} after {n} samples");
