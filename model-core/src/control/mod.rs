@@ -5,11 +5,15 @@
 //! ([`Estimator`](crate::Estimator), any model) → torque PI with anti-windup ([`pi`]) plus the
 //! feed-forward from the inverse of the model's static part ([`feedforward`]) → coil current
 //! PI → H-bridge duty with the demagnetising pulse ([`pwm`]). The [`supervisor`] checks every
-//! sample for implausible readings and latches a fault code; any fault ends in the safe
+//! sample for what must act at once (Hall at a rail, over-current, supply outside its window,
+//! overrun, model output non-finite) and latches a fault code; any fault ends in the safe
 //! state (PWM off, bridge high-impedance so the coil de-energises through the diodes).
 //! What need not run every sample runs in [`step::ControlStep::slow`] (about 1 kHz): the
-//! configuration check, the time-step check, the temperature compensation and the
-//! feed-forward's slope; the per-sample step trips if that pass stalls.
+//! configuration check, the time-step check, the temperature compensation, the
+//! feed-forward's slope, and the slow-developing checks (Hall noise, stuck Hall, coil open,
+//! B/i band), judged on the samples the step logged since the previous pass (their fault
+//! latency: their sample count plus at most one slow period plus one sample); the
+//! per-sample step trips if that pass stalls.
 //! Settings are a [`config::ValidatedConfig`]: validated once, CRC-protected, swapped in
 //! between samples by replacing a `Copy` value. The flash page that holds the model, its
 //! parameters and these settings is [`page`].

@@ -47,26 +47,29 @@ pub struct Demag {
 pub struct DemagState {
     pub armed: bool,
     pub remaining: u16,
-    /// Sign of the current before the pulse.
+    /// The current before the pulse, A (its sign sets the pulse's: stored as it is, the
+    /// sign is taken only while the pulse runs).
     pub sign: f32,
 }
 
 impl Demag {
     /// Feed the command and the coil current; `Some(duty)` while the pulse overrides the loop.
     pub fn step(&self, s: &mut DemagState, command: f32, i: f32) -> Option<f32> {
+        // Against the current before the pulse (0 counts as positive).
+        let pulse = if s.sign < 0.0 { self.duty } else { -self.duty };
         if s.remaining > 0 {
             s.remaining -= 1;
-            return Some(-s.sign * self.duty);
+            return Some(pulse);
         }
         let mag = crate::math::abs(command);
         if mag >= self.threshold {
             s.armed = true;
-            s.sign = if i < 0.0 { -1.0 } else { 1.0 };
+            s.sign = i;
         } else if s.armed && mag < 0.25 * self.threshold {
             s.armed = false;
             if self.samples > 0 {
                 s.remaining = self.samples - 1;
-                return Some(-s.sign * self.duty);
+                return Some(pulse);
             }
         }
         None

@@ -13,8 +13,12 @@
 //!   equally bounded path.
 //! - [`ControlStep::slow`], about 1 kHz from a lower-priority task: the checks that need
 //!   not run every sample (configuration fingerprint and coefficients, model/configuration
-//!   time step) and the temperature compensation. A fault it finds is latched and trips
-//!   the next sample; a step that sees no slow pass for
+//!   time step, and the slow-developing supervisor checks — Hall noise, stuck Hall, coil
+//!   open, B/i band — replayed from the [`SampleLog`] the step writes, a few instructions
+//!   a sample) and the temperature compensation. A fault it finds is latched and trips
+//!   the next sample, so a slow-developing fault trips within its own sample count plus
+//!   one slow period plus one sample (at 20 kHz with the 1 kHz pass: ≤ 21 samples later
+//!   than when it was judged every sample); a step that sees no slow pass for
 //!   [`SLOW_TIMEOUT_S`](super::config::SLOW_TIMEOUT_S) trips
 //!   [`FaultCode::SupervisorStalled`], and the loop does not start before a first pass.
 
@@ -24,7 +28,7 @@ use super::feedforward::{chord_step, inverse_slope, static_output, StaticMap};
 use super::pi::{clamp, step_limited, PiState};
 use super::pwm::{quantise, Demag, DemagState};
 use super::supervisor::{
-    self, confirm, fast_any, fast_any_clamped, fast_code, Fast, FaultCode, SupState, SLOW_LATCHED,
+    self, confirm, fast_any, fast_any_clamped, fast_code, Fast, FaultCode, SampleLog, SupState, SLOW_LATCHED,
 };
 use crate::rate::RateParams;
 use crate::{Estimator, EstimatorState, Model, ParamError};
@@ -117,6 +121,8 @@ pub struct ControlState<S> {
     pub pi_t: PiState,
     pub pi_i: PiState,
     pub sup: SupState,
+    /// The running samples since the last slow pass, for its slow-developing checks.
+    pub log: SampleLog,
     pub demag: DemagState,
     /// Voltage commanded on the previous sample, V.
     pub last_v: f32,
@@ -137,7 +143,7 @@ pub struct ControlState<S> {
 
 impl<S: Default> ControlState<S> {
     /// Back to [`Default`] (mode `Init`), field by field: no state-sized temporary on the
-    /// stack of the step.
+    /// stack of the step. The sample log keeps its (unread) contents.
     #[inline(never)]
     pub fn reset(&mut self) {
         self.mode = Mode::Init;
@@ -149,6 +155,8 @@ impl<S: Default> ControlState<S> {
         self.pi_t = PiState::default();
         self.pi_i = PiState::default();
         self.sup = SupState::default();
+        // `log` is left as it is: the slow pass reads only entries recorded since the loop
+        // (re)started (`SupState::log_start`), and clearing 512 B would double this call.
         self.demag = DemagState::default();
         self.last_v = 0.0;
         self.b_star = 0.0;
@@ -199,20 +207,19 @@ fn slow_verdict(k: &Coeffs, sup: &SupState) -> FaultCode {
 }
 
 /// A running sample tripped: the code in priority order (the slow pass's verdict, its
-/// fault or a stall; the fast conditions; the slow-developing checks) and the safe-state
-/// output. One cold leaf function (no nested calls), so the trip path adds no stack frame.
+/// fault, which includes the slow-developing checks, or a stall; the fast conditions) and
+/// the safe-state output. One cold leaf function (no nested calls), so the trip path adds
+/// no stack frame.
 #[cold]
 #[inline(never)]
 fn tripped<S>(k: &Coeffs, s: &mut ControlState<S>, x: &ControlInput, b: f32, i: f32) -> ControlOutput {
     let slow = slow_verdict(k, &s.sup);
     let code = if slow != FaultCode::None {
         slow
-    } else if s.sup.fast >= k.confirm {
+    } else {
         // The model-held condition is the last in the order: no need to pass it.
         let f = Fast { hall: x.hall, i, supply_v: x.supply_v, overrun: x.overrun, model_bad: true };
         supervisor::fast_code_inline(k, &f)
-    } else {
-        supervisor::running_code_inline(k, &s.sup)
     };
     s.mode = Mode::Fault(code);
     s.last_v = 0.0;
@@ -235,15 +242,21 @@ impl<M: Model> ControlStep<M> {
     /// than the sample interrupt: checks the RAM copy of the configuration
     /// ([`ValidatedConfig::verify`]) and that its time step is the model's, latching
     /// [`FaultCode::ConfigCrc`] or [`FaultCode::ConfigMismatch`] for the next sample to
-    /// trip; sets the temperature compensation from `temperature` (°C, NaN: no sensor)
+    /// trip; while the loop runs, replays the samples logged since the previous pass
+    /// through the slow-developing checks ([`SampleLog::judge`]: Hall noise, stuck Hall,
+    /// coil open, B/i band) and latches what they find likewise; sets the temperature compensation from `temperature` (°C, NaN: no sensor)
     /// and the torque floor (the model's static torque at B = 0 from its present state).
     pub fn slow(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, temperature: f32) {
         let c = cfg.get();
         let dt_ok = crate::math::abs(c.dt - self.est.model.dt()) <= 1e-6 * c.dt;
+        let n = s.sup.since_slow;
         let code = if !cfg.verify() {
             FaultCode::ConfigCrc
         } else if !dt_ok {
             FaultCode::ConfigMismatch
+        } else if s.mode == Mode::Running && n < SLOW_LATCHED {
+            let (start, offsets) = (s.sup.log_start, (s.hall_offset, s.current_offset));
+            s.log.judge(cfg.coeffs(), &mut s.sup, start, n, offsets)
         } else {
             FaultCode::None
         };
@@ -262,6 +275,7 @@ impl<M: Model> ControlStep<M> {
         s.t_floor = finite_or(t_static(0.0), 0.0);
         s.ff_inv_slope = inverse_slope(t_static, s.b_star, cfg.coeffs().ff_h);
         s.sup.since_slow = if s.sup.slow_fault == FaultCode::None { 0 } else { SLOW_LATCHED };
+        s.sup.log_start = 0;
         s.sup.slow_seen = true;
     }
 
@@ -357,7 +371,10 @@ impl<M: Model> ControlStep<M> {
     #[inline(never)]
     fn run(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: &ControlInput) -> ControlOutput {
         let k = cfg.coeffs();
-        s.sup.since_slow = s.sup.since_slow.wrapping_add(1);
+        let n = s.sup.since_slow.wrapping_add(1);
+        s.sup.since_slow = n;
+        // The slow-developing checks run in the slow pass, on this record of the sample.
+        s.log.record(n, x.hall, x.current, s.last_v);
         // Finite by construction: u16 counts, validated gains and offsets.
         let b = counts_to_units(x.hall, s.hall_offset, k.hall_gain);
         let i = counts_to_units(x.current, s.current_offset, k.current_gain);
@@ -370,9 +387,8 @@ impl<M: Model> ControlStep<M> {
         let supply = clamp(x.supply_v, k.v_min, k.v_max);
         let f = Fast { hall: x.hall, i, supply_v: x.supply_v, overrun: x.overrun, model_bad };
         let fast = confirm(k, &mut s.sup, fast_any_clamped(k, &f, supply));
-        let slow_developing = supervisor::running(k, &mut s.sup, x.hall, b, i, s.last_v);
-        let slow = s.sup.since_slow > k.slow_timeout;
-        if fast | slow | slow_developing {
+        let slow = n > k.slow_timeout;
+        if fast | slow {
             return tripped(k, s, x, b, i);
         }
 
@@ -528,7 +544,8 @@ mod tests {
         assert_eq!((o.pwm_enable, o.duty, o.fault), (false, 0.0, FaultCode::HallOpen));
         let o = tick(&step, &cfg, &mut s, ControlInput { reset: true, ..ControlInput::new(2048, 2048, 24.0, 0.0) });
         assert_eq!(o.mode, Mode::Init);
-        assert_eq!(s, ControlState::default(), "reset is the default state");
+        // The default state, but for the sample log's stale entries (never read again).
+        assert_eq!(ControlState { log: SampleLog::default(), ..s }, ControlState::default(), "reset is the default");
     }
 
     #[test]
@@ -556,6 +573,56 @@ mod tests {
         let (k, o) = tripped.unwrap();
         assert!(k + 70 >= timeout, "tripped early, after {k} samples");
         assert_eq!((o.fault, o.pwm_enable), (FaultCode::SupervisorStalled, false));
+    }
+
+    /// Each slow-developing check, now judged in the slow pass from the sample log, still
+    /// trips on a synthetic fault: with the code of the check, on the sample after the slow
+    /// pass that sees its count reached, within its count plus one slow period (10 samples
+    /// here) plus one sample. Without slow passes the per-sample step alone does not trip.
+    #[test]
+    fn slow_developing_checks_trip_through_the_slow_pass() {
+        // (check, count, reference, fault input at sample k of the injection)
+        type Case = (FaultCode, u32, f32, fn(u16) -> (u16, u16));
+        let cases: [Case; 4] = [
+            (FaultCode::HallStuck, 12, 0.0, |_| (2100, 2047)),
+            (FaultCode::HallNoise, 4, 0.0, |k| (if k % 2 == 0 { 2100 } else { 2000 }, 2047)),
+            // 1 A asked, no current flows: the current PI drives the full voltage.
+            (FaultCode::CoilOpen, 10, 1.0, |k| (2048 + k % 3, 2047 + k % 2)),
+            // 0.5 T with no current (band 0.05 T below).
+            (FaultCode::BImplausible, 10, 0.0, |k| (2048 + 819 + k % 3, 2047)),
+        ];
+        for (code, count, reference, fault) in cases {
+            let (step, _) = setup(LoopMode::Current);
+            let cfg = ControlConfig { b_band: 0.05, calib_samples: 10.0, ..ControlConfig::defaults(DT) };
+            let cfg = ControlConfig { mode: LoopMode::Current, ..cfg }.validate().unwrap();
+            let mut s = step.state();
+            for k in 0..30u16 {
+                tick(&step, &cfg, &mut s, ControlInput::new(2048 + k % 3, 2047, 24.0, 0.0));
+            }
+            assert_eq!(s.mode, Mode::Running, "{code:?}");
+            // Without a slow pass (it runs before every 10th sample), nothing trips.
+            let mut quiet = s;
+            for k in 0..50u16 {
+                let (hall, current) = fault(k);
+                let o = step.step(&cfg, &mut quiet, ControlInput::new(hall, current, 24.0, reference));
+                assert_eq!(o.fault, FaultCode::None, "{code:?} tripped in the per-sample step");
+            }
+            let mut tripped = None;
+            for k in 0..60u16 {
+                let (hall, current) = fault(k);
+                let slow_before = s.sup.since_slow >= 10;
+                let o = tick(&step, &cfg, &mut s, ControlInput::new(hall, current, 24.0, reference));
+                if o.fault != FaultCode::None {
+                    tripped = Some((u32::from(k) + 1, o, slow_before));
+                    break;
+                }
+            }
+            assert!(tripped.is_some(), "{code:?} did not trip");
+            let (n, o, slow_before) = tripped.unwrap();
+            assert_eq!((o.fault, o.pwm_enable, o.mode), (code, false, Mode::Fault(code)));
+            assert!(slow_before, "{code:?}: tripped on a sample without a slow pass before it");
+            assert!(n >= count.min(4) && n <= count + 10 + 1, "{code:?} after {n} samples");
+        }
     }
 
     #[test]

@@ -4,19 +4,28 @@
 //! freewheeling diodes against the supply. An MR clutch without field transmits only its
 //! small viscous drag (the safe state of a collaborative-robot joint, seed 000 §1).
 //!
-//! Three tiers, so the per-sample cost stays small:
-//! - [`fast_any`], every sample in every active mode: the conditions that need
-//!   `confirm_samples` consecutive samples (Hall at a rail, over-current, supply outside
-//!   its window, overrun, model output held) as one combined test with one counter: any of
-//!   them on every one of `confirm` consecutive samples trips (at least as sensitive as a
-//!   counter per condition). The code, in priority order, is worked out only when it trips
-//!   ([`fast_code`]).
-//! - [`running`], every sample while the loop is closed: the slow-developing checks with
-//!   their own counters (Hall noise, stuck Hall, coil open, B inconsistent with i).
+//! Two places, so the per-sample cost stays small:
+//! - [`fast_any`], every sample in every active mode: what must act within a few samples
+//!   (Hall at a rail, over-current, supply outside its window, overrun, model output held)
+//!   as one combined test with one counter: any of them on every one of `confirm`
+//!   consecutive samples trips (at least as sensitive as a counter per condition). The
+//!   code, in priority order, is worked out only when it trips ([`fast_code`]).
 //! - [`ControlStep::slow`](super::ControlStep::slow), about 1 kHz from a lower-priority
 //!   task: the configuration fingerprint, the model/configuration time step, the
-//!   temperature compensation. Its result is latched in [`SupState::slow_fault`]; the
-//!   per-sample step trips [`FaultCode::SupervisorStalled`] if it stops running.
+//!   temperature compensation, and the slow-developing checks (Hall noise, stuck Hall,
+//!   coil open, B inconsistent with i). For those the per-sample step only records its raw
+//!   sample (Hall and current counts, the voltage applied) in the [`SampleLog`], a few
+//!   instructions; the slow pass replays the samples since its previous pass through
+//!   [`running`], with the same counters and limits as when they ran every sample, and
+//!   latches the first fault in [`SupState::slow_fault`]. The per-sample step trips on the
+//!   next sample, and trips [`FaultCode::SupervisorStalled`] if the slow pass stops running.
+//!
+//! Fault latency of the slow-developing checks: their own sample count (as before) plus at
+//! most one slow period (the pass that sees the count reached) plus one sample (the trip);
+//! at 20 kHz with the 1 kHz pass, ≤ 20 samples (1 ms) more than when they were judged every
+//! sample. A slow pass later than [`LOG_SAMPLES`] samples judges the last
+//! [`LOG_SAMPLES`] only: the counters count observed samples and carry on across the gap,
+//! so a persistent fault still trips.
 
 use super::config::Coeffs;
 
@@ -108,6 +117,66 @@ pub struct SupState {
     pub since_slow: u32,
     /// A slow pass has run since this state was reset (the loop does not start before).
     pub slow_seen: bool,
+    /// `since_slow` on the sample that entered `Running`: the slow pass replays the log
+    /// entries after it (entries before are not the running loop's).
+    pub log_start: u32,
+}
+
+/// Entries of the [`SampleLog`] (a power of two): at 20 kHz, 3.2 ms of samples, so a
+/// slow pass (1 kHz) may be 2.2 ms late before samples go unjudged.
+pub const LOG_SAMPLES: usize = 64;
+
+/// One running sample as the slow-developing checks need it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LogEntry {
+    /// Hall counts (low half) and coil-current counts (high half).
+    pub counts: u32,
+    /// Voltage commanded on the previous sample, V.
+    pub v_applied: f32,
+}
+
+/// Ring of the running samples since the last slow pass, written at index
+/// `since_slow mod LOG_SAMPLES` by the per-sample step, replayed by the slow pass.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SampleLog(pub [LogEntry; LOG_SAMPLES]);
+
+impl Default for SampleLog {
+    fn default() -> Self {
+        Self([LogEntry::default(); LOG_SAMPLES])
+    }
+}
+
+impl SampleLog {
+    /// Record a running sample at position `n` (`since_slow` of that sample). Branch-free,
+    /// no bounds check (the index is masked).
+    #[inline(always)]
+    pub fn record(&mut self, n: u32, hall: u16, current: u16, v_applied: f32) {
+        if let Some(e) = self.0.get_mut(n as usize & (LOG_SAMPLES - 1)) {
+            *e = LogEntry { counts: u32::from(hall) | (u32::from(current) << 16), v_applied };
+        }
+    }
+
+    /// Replay the entries after `start` up to `end` (positions as [`record`](Self::record)
+    /// got them; at most the last [`LOG_SAMPLES`]) through [`running`], converting the
+    /// counts with the offsets (counts) and the gains of `k`. Returns the first fault found
+    /// ([`running_code`]), or `None`.
+    pub fn judge(&self, k: &Coeffs, s: &mut SupState, start: u32, end: u32, offsets: (f32, f32)) -> FaultCode {
+        let first = start.max(end.saturating_sub(LOG_SAMPLES as u32)).wrapping_add(1);
+        let mut n = first;
+        while n <= end {
+            if let Some(e) = self.0.get(n as usize & (LOG_SAMPLES - 1)) {
+                let hall = (e.counts & 0xFFFF) as u16;
+                let current = (e.counts >> 16) as u16;
+                let b = super::calibration::counts_to_units(hall, offsets.0, k.hall_gain);
+                let i = super::calibration::counts_to_units(current, offsets.1, k.current_gain);
+                if running(k, s, hall, b, i, e.v_applied) {
+                    return running_code(k, s);
+                }
+            }
+            n = n.wrapping_add(1);
+        }
+        FaultCode::None
+    }
 }
 
 /// [`SupState::since_slow`] after a slow pass that found a fault.
@@ -184,6 +253,7 @@ pub fn fast_code_inline(k: &Coeffs, f: &Fast) -> FaultCode {
 /// Start the slow-developing checks from this sample (on entering `Running`).
 #[inline]
 pub fn prime(s: &mut SupState, hall: u16) {
+    s.log_start = s.since_slow;
     s.last_hall = hall;
     s.last_jump = 0;
     s.slew_hist = 0;
@@ -199,7 +269,8 @@ fn count(c: &mut u32, cond: bool) -> u32 {
     *c
 }
 
-/// The slow-developing checks of one running sample: Hall `hall` (counts) and `b` (T),
+/// The slow-developing checks of one running sample (replayed by the slow pass from the
+/// [`SampleLog`]): Hall `hall` (counts) and `b` (T),
 /// coil current `i` (A), the voltage commanded on the previous sample `v_applied` (V).
 /// True when one of them trips ([`running_code`] tells which).
 #[inline(always)]
@@ -233,7 +304,7 @@ pub fn running_code(k: &Coeffs, s: &SupState) -> FaultCode {
     running_code_inline(k, s)
 }
 
-/// [`running_code`], inlined (for a caller that must not grow its stack).
+/// [`running_code`], inlined.
 #[inline(always)]
 pub fn running_code_inline(k: &Coeffs, s: &SupState) -> FaultCode {
     if u32::from(s.slew_n) >= k.slew_n {
