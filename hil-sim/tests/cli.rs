@@ -82,3 +82,50 @@ fn errors_are_one_line_and_nonzero() {
     assert!(v["metrics"]["rmse"].as_f64().unwrap() < 1e-6);
     assert!(v["metrics"]["r2"].as_f64().unwrap() > 0.999_999);
 }
+
+#[test]
+fn diagnose_json_follows_the_contract_on_a_concealed_recording() {
+    let dir = std::env::temp_dir().join(format!("hil-sim-diagnose-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let rec = dir.join("lag.csv");
+    let label = dir.join("lag.label.json");
+    let (code, _, err) = hil_sim(&[
+        "simulate",
+        "--effect",
+        "field_lag",
+        "--base",
+        "algebraic",
+        "--excitation",
+        "noise",
+        "--duration",
+        "10",
+        "--fs",
+        "1000",
+        "--out",
+        rec.to_str().unwrap(),
+        "--label",
+        label.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let csv = std::fs::read_to_string(&rec).unwrap();
+    assert!(csv.starts_with("t,b,torque,i,speed,temperature\n") && !csv.contains("lag"));
+    let (code, out, err) = hil_sim(&["diagnose", rec.to_str().unwrap(), "--model", "algebraic", "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).expect("one JSON object");
+    assert_eq!(v["base_model"], "algebraic");
+    assert_eq!(v["heldout_fraction"], 0.3);
+    let f = &v["findings"][0];
+    assert_eq!(f["effect"], "field_lag", "{out}");
+    assert!(f["summary"].as_str().unwrap().contains("ms"));
+    assert!(f["params"]["tau_s"].as_f64().unwrap() > 0.0);
+    assert!(f["windows"].is_array());
+    assert!(f["heldout_after"]["r_rmse"].as_f64().unwrap() < f["heldout_before"]["r_rmse"].as_f64().unwrap());
+    // Bad input: one clear error each.
+    let (code, _, err) = hil_sim(&["diagnose", rec.to_str().unwrap(), "--model", "nope"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("unknown model"), "{err}");
+    let (code, _, err) = hil_sim(&["simulate", "--effect", "warp", "--out", dir.join("x.csv").to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert!(err.contains("field_lag"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -154,5 +154,10 @@ fn concealed_effects_are_named_and_null_recordings_give_nothing() {
     // test holds that line: a change that loses a case, or raises a false alarm, fails here.
     let false_alarms: Vec<&String> = bad.iter().filter(|b| b.starts_with("none ")).collect();
     assert!(false_alarms.is_empty(), "false alarms:\n{false_alarms:?}\n\n{table}");
-    assert!(bad.len() <= MAX_MISSES, "{} effect cases missed (at most {MAX_MISSES}):\n{}\n\n{table}", bad.len(), bad.join("\n"));
+    assert!(
+        bad.len() <= MAX_MISSES,
+        "{} effect cases missed (at most {MAX_MISSES}):\n{}\n\n{table}",
+        bad.len(),
+        bad.join("\n")
+    );
 }

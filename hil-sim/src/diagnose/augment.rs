@@ -195,15 +195,19 @@ impl Simulator for AugSim<'_, '_> {
         p.get(..self.n_base()).is_some_and(|t| self.prob.sim.valid(t))
     }
     fn run(&self, p: &[f64], _kin: &[model_core::Kin], out: &mut [f64]) -> bool {
-        match self.full(p) {
-            Some((_, _, pred, _, _, _)) => {
-                for (o, v) in out.iter_mut().zip(&pred) {
-                    *o = *v;
-                }
-                pred.iter().all(|v| v.is_finite())
-            }
-            None => false,
+        // Only the samples the objective scores (up to its last training row).
+        let (Some(theta), Some(piece)) =
+            (p.get(..self.n_base()), self.at(p.get(self.n_base()).copied().unwrap_or(0.0)))
+        else {
+            return false;
+        };
+        let (kin, _, terms) = &*piece;
+        let Some(m) = kin.get(..out.len()).and_then(|k| self.prob.run_kin(theta, k)) else { return false };
+        let Some((_, pred, _)) = self.prob.solve_terms(terms, &m) else { return false };
+        for (o, v) in out.iter_mut().zip(&pred) {
+            *o = *v;
         }
+        pred.iter().all(|v| v.is_finite())
     }
 }
 

@@ -107,6 +107,22 @@ pub fn rates(data: &Dataset) -> (Vec<f64>, Vec<f64>) {
     data.rates.clone().unwrap_or_else(|| crate::rate_offline::rates(&data.input, data.dt))
 }
 
+/// Correlation of `v` with the input's acceleration `ddx` beyond what the input `x` itself
+/// explains (partial correlation given `x`). A channel that mostly follows the input (a
+/// coil current next to its field) correlates with `ẍ` under a band-limited input only
+/// through `x` (for a narrow band `ẍ ≈ −ω²x`); a measured acceleration keeps its correlation
+/// once `x` is taken out. Falls back to the plain correlation when `ẍ` is `x` up to a
+/// factor (a pure sine).
+fn acceleration_corr(v: &[f64], x: &[f64], ddx: &[f64]) -> f64 {
+    let (r_vd, r_vx, r_dx) = (corr(v, ddx), corr(v, x), corr(ddx, x));
+    let den = ((1.0 - r_vx * r_vx) * (1.0 - r_dx * r_dx)).sqrt();
+    if 1.0 - r_dx * r_dx < 1e-4 || den <= 1e-12 {
+        r_vd
+    } else {
+        (r_vd - r_vx * r_dx) / den
+    }
+}
+
 /// Classify the recording's auxiliary channels `aux` (name, values).
 pub fn classify(data: &Dataset, aux: Vec<(String, Vec<f64>)>, command: Option<&str>) -> Vec<AuxChannel> {
     let (dx, ddx) = rates(data);
@@ -121,7 +137,7 @@ pub fn classify(data: &Dataset, aux: Vec<(String, Vec<f64>)>, command: Option<&s
                 Role::Unused
             } else if corr(&values, &dx).abs() >= 0.9 {
                 Role::InputRate
-            } else if corr(&values, &ddx).abs() >= 0.6 {
+            } else if acceleration_corr(&values, &data.input, &ddx).abs() >= 0.6 {
                 Role::InputAcceleration
             } else if ["temp", "theta", "oil", "therm"].iter().any(|k| lower.contains(k)) {
                 Role::Temperature
@@ -343,4 +359,34 @@ pub fn all(data: &Dataset, aux: &[AuxChannel]) -> Vec<Candidate> {
         });
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A two-tone input, its exact acceleration, a coil-current-like channel (the input plus
+    /// a lead term) and a measured acceleration (the exact one plus noise).
+    fn signals() -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+        let (w1, w2, tau) = (std::f64::consts::TAU * 5.0, std::f64::consts::TAU * 7.0, 0.002);
+        let t: Vec<f64> = (0..20_000).map(|k| k as f64 * 5e-4).collect();
+        let x: Vec<f64> = t.iter().map(|t| (w1 * t).sin() + 0.5 * (w2 * t).sin()).collect();
+        let dx: Vec<f64> = t.iter().map(|t| w1 * (w1 * t).cos() + 0.5 * w2 * (w2 * t).cos()).collect();
+        let ddx: Vec<f64> = t.iter().map(|t| -w1 * w1 * (w1 * t).sin() - 0.5 * w2 * w2 * (w2 * t).sin()).collect();
+        let current: Vec<f64> = x.iter().zip(&dx).map(|(x, d)| 0.3 + x + tau * d).collect();
+        let accel: Vec<f64> =
+            ddx.iter().enumerate().map(|(k, a)| a + 200.0 * ((k as f64 * 12.9898).sin() * 43758.5453).fract()).collect();
+        (x, ddx, current, accel)
+    }
+
+    #[test]
+    fn a_channel_following_the_input_is_not_its_acceleration() {
+        let (x, ddx, current, accel) = signals();
+        // Under a narrow band the plain correlation cannot tell them apart ...
+        assert!(corr(&current, &ddx).abs() > 0.6, "{}", corr(&current, &ddx));
+        assert!(corr(&accel, &ddx).abs() > 0.6);
+        // ... the correlation beyond the input can.
+        assert!(acceleration_corr(&current, &x, &ddx).abs() < 0.3, "{}", acceleration_corr(&current, &x, &ddx));
+        assert!(acceleration_corr(&accel, &x, &ddx).abs() > 0.6, "{}", acceleration_corr(&accel, &x, &ddx));
+    }
 }

@@ -60,6 +60,8 @@ const POLISHED: usize = 3;
 /// Grid points of an input transform's profiled scan, and the iterations of each.
 const PROFILE_POINTS: usize = 8;
 const PROFILE_ITERATIONS: usize = 2;
+/// Samples (from the start) whose training rows rank an input transform's grid values.
+const PROFILE_SAMPLES: usize = 20_000;
 
 /// Why a diagnosis could not run.
 #[derive(Debug, Error)]
@@ -533,6 +535,15 @@ fn starts_on_grid(prob: &Problem<'_>, c: &Candidate, current: &Fitted, jac: &[Ve
     if c.grid.first().is_some_and(|&g| (c.build)(g).transform.is_some()) {
         let step = c.grid.len().div_ceil(PROFILE_POINTS).max(1);
         let coarse: Vec<f64> = c.grid.iter().copied().step_by(step).collect();
+        // The first PROFILE_SAMPLES of the training part rank the grid values.
+        let short = Problem {
+            data: prob.data,
+            sim: prob.sim,
+            spec: prob.spec,
+            rate: prob.rate,
+            train: prob.train.iter().copied().take_while(|&i| i < PROFILE_SAMPLES).collect(),
+        };
+        let prob = if short.train.len() >= 1000 { &short } else { prob };
         let costs: Vec<f64> = coarse
             .par_iter()
             .map(|&g| {
