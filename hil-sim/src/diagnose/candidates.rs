@@ -374,8 +374,11 @@ mod tests {
         let dx: Vec<f64> = t.iter().map(|t| w1 * (w1 * t).cos() + 0.5 * w2 * (w2 * t).cos()).collect();
         let ddx: Vec<f64> = t.iter().map(|t| -w1 * w1 * (w1 * t).sin() - 0.5 * w2 * w2 * (w2 * t).sin()).collect();
         let current: Vec<f64> = x.iter().zip(&dx).map(|(x, d)| 0.3 + x + tau * d).collect();
-        let accel: Vec<f64> =
-            ddx.iter().enumerate().map(|(k, a)| a + 200.0 * ((k as f64 * 12.9898).sin() * 43758.5453).fract()).collect();
+        let accel: Vec<f64> = ddx
+            .iter()
+            .enumerate()
+            .map(|(k, a)| a + 200.0 * ((k as f64 * 12.9898).sin() * 43758.5453).fract())
+            .collect();
         (x, ddx, current, accel)
     }
 
