@@ -2,17 +2,21 @@
 //! missing-physics catalog (`hil-sim simulate --effect`), and on recordings with none.
 //!
 //! The suite is fixed in advance: every effect a clutch recording with these base models
-//! can show, on two base models and excitations (Bouc–Wen under a multi-sine, the
-//! algebraic model under band-limited noise), plus one null recording per base model, all
-//! 30 s at 2 kHz, 4 % of the torque span, with seeds not used while developing. The
-//! diagnosis is told the base model the user fits (the truth's model) and nothing about the
-//! effect; the label stays in the generator. `sensor_offset` is not in the suite: these
-//! base models absorb an offset of their input almost entirely (see docs/diagnose.md).
+//! can show, on three base models and excitations (Bouc–Wen under a multi-sine, the
+//! algebraic model and the Dahl model under band-limited noise), plus one null recording
+//! on each of these and of LuGre under a multi-sine and the tanh model under a triangle,
+//! all 30 s at 2 kHz, 4 % of the torque span. The diagnosis is told the
+//! base model the user fits (the truth's model) and nothing about the effect; the label
+//! stays in the generator. `sensor_offset` is not in the suite: these base models absorb
+//! an offset of their input almost entirely (see docs/diagnose.md).
 //!
-//! The test prints the table that docs/diagnose.md carries (and writes it to
-//! `target/concealed_suite.md`), then asserts no finding on every null case and at most
-//! [`MAX_MISSES`] wrong top findings over the effect cases (the issue asks for none; the
-//! misses are documented there).
+//! [`concealed_effects_are_named_and_null_recordings_give_nothing`] prints the table that
+//! docs/diagnose.md carries (and writes it to `target/concealed_suite.md`), then asserts
+//! the right top finding on every effect case and no finding on every null case.
+//! [`hard_bases_characterised`] (ignored: run it with `--ignored`) does the same on the two
+//! pairs where the diagnosis is known to misname some effects (LuGre under a multi-sine,
+//! the tanh model under a triangle) and only prints its table (`target/concealed_hard.md`):
+//! those misses are documented, not hidden.
 
 use std::path::Path;
 
@@ -33,10 +37,6 @@ const EFFECTS: [&str; 9] = [
     "inertia",
     "aux_dependence",
 ];
-
-/// Effect cases this build names wrongly (transport_delay on Bouc–Wen, named field_lag;
-/// aux_dependence on the algebraic model, named inertia); see docs/diagnose.md.
-const MAX_MISSES: usize = 2;
 
 struct Outcome {
     effect: String,
@@ -97,21 +97,18 @@ fn run(effect: &str, base: &str, excitation: &str, seed: u64) -> Outcome {
     }
 }
 
-#[test]
-fn concealed_effects_are_named_and_null_recordings_give_nothing() {
+/// Runs every effect on each `(base, excitation, seed)` pair of `pairs`, and a null case on
+/// each pair of `pairs` and `nulls`; the table and the cases whose outcome was wrong
+/// (`effect on base/excitation: findings`).
+fn suite(pairs: &[(&str, &str, u64)], nulls: &[(&str, &str, u64)], file: &str) -> (String, Vec<String>) {
     let mut cases: Vec<(&str, &str, &str, u64)> = Vec::new();
-    for e in EFFECTS {
-        cases.push((e, "bouc_wen", "multisine", 21));
-        cases.push((e, "algebraic", "noise", 22));
+    for &(base, exc, seed) in pairs {
+        for e in EFFECTS {
+            cases.push((e, base, exc, seed));
+        }
     }
-    for (base, exc) in [
-        ("bouc_wen", "multisine"),
-        ("algebraic", "noise"),
-        ("lugre", "multisine"),
-        ("tanh", "triangle"),
-        ("dahl", "noise"),
-    ] {
-        cases.push(("none", base, exc, 23));
+    for &(base, exc, seed) in pairs.iter().chain(nulls) {
+        cases.push(("none", base, exc, seed + 100));
     }
     let outcomes: Vec<Outcome> = cases.iter().map(|&(e, b, x, s)| run(e, b, x, s)).collect();
     let mut table = String::from(
@@ -148,16 +145,25 @@ fn concealed_effects_are_named_and_null_recordings_give_nothing() {
     println!("{table}");
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target");
     let _ = std::fs::create_dir_all(&dir);
-    let _ = std::fs::write(dir.join("concealed_suite.md"), &table);
-    // Every null recording must stay clean. The issue asks for the right top finding on every
-    // effect case; this build names 16 of 18 (the two misses are in docs/diagnose.md), so the
-    // test holds that line: a change that loses a case, or raises a false alarm, fails here.
-    let false_alarms: Vec<&String> = bad.iter().filter(|b| b.starts_with("none ")).collect();
-    assert!(false_alarms.is_empty(), "false alarms:\n{false_alarms:?}\n\n{table}");
-    assert!(
-        bad.len() <= MAX_MISSES,
-        "{} effect cases missed (at most {MAX_MISSES}):\n{}\n\n{table}",
-        bad.len(),
-        bad.join("\n")
+    let _ = std::fs::write(dir.join(file), &table);
+    (table, bad)
+}
+
+#[test]
+fn concealed_effects_are_named_and_null_recordings_give_nothing() {
+    let (table, bad) = suite(
+        &[("bouc_wen", "multisine", 21), ("algebraic", "noise", 22), ("dahl", "noise", 25)],
+        &[("lugre", "multisine", 24), ("tanh", "triangle", 26)],
+        "concealed_suite.md",
     );
+    assert!(bad.is_empty(), "{} cases wrong:\n{}\n\n{table}", bad.len(), bad.join("\n"));
+}
+
+/// LuGre under a multi-sine and the tanh model under a triangle: characterised, not
+/// asserted (docs/diagnose.md lists their misses).
+#[test]
+#[ignore = "characterisation of the known-weak pairs (≈ 2 min); run with --ignored"]
+fn hard_bases_characterised() {
+    let (_, bad) = suite(&[("lugre", "multisine", 24), ("tanh", "triangle", 26)], &[], "concealed_hard.md");
+    println!("{} cases wrong:\n{}", bad.len(), bad.join("\n"));
 }

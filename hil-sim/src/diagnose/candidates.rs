@@ -294,7 +294,7 @@ pub fn all(data: &Dataset, aux: &[AuxChannel]) -> Vec<Candidate> {
         let v = centred(&t.values);
         out.push(Candidate {
             effect: "thermal_drift",
-            label: format!("drift with the temperature {}", t.name),
+            label: format!("drift with the channel {} (a temperature)", t.name),
             grid_name: None,
             grid: vec![0.0],
             build: Box::new(move |_| Piece {
@@ -309,7 +309,7 @@ pub fn all(data: &Dataset, aux: &[AuxChannel]) -> Vec<Candidate> {
         let vb: Vec<f64> = v.iter().zip(&x).map(|(v, x)| v * x / x_max).collect();
         out.push(Candidate {
             effect: "slip_speed",
-            label: format!("viscous term in the speed {}", s.name),
+            label: format!("viscous term in the channel {} (a speed)", s.name),
             grid_name: None,
             grid: vec![0.0],
             build: Box::new(move |_| Piece {

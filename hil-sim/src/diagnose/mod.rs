@@ -57,11 +57,14 @@ const SCREEN_ITERATIONS: usize = 3;
 /// judged against gets both.
 const POLISH_ITERATIONS: usize = 6;
 const POLISHED: usize = 3;
-/// Grid points of an input transform's profiled scan, and the iterations of each.
+/// Grid points of an input transform's profiled scan on each side of the identity, and the
+/// iterations of each refit.
 const PROFILE_POINTS: usize = 8;
-const PROFILE_ITERATIONS: usize = 2;
+const PROFILE_ITERATIONS: usize = 3;
+/// Grid values between two starts for them to count as different basins.
+const PROFILE_GAP: usize = 2;
 /// Samples (from the start) whose training rows rank an input transform's grid values.
-const PROFILE_SAMPLES: usize = 20_000;
+const PROFILE_SAMPLES: usize = 12_000;
 
 /// Why a diagnosis could not run.
 #[derive(Debug, Error)]
@@ -365,7 +368,7 @@ pub fn diagnose(
                 let c = &cands[*k];
                 let base = Fitted { terms: f.terms[..reference.terms.len()].to_vec(), ..reference.clone() };
                 let base = Fitted { theta: f.theta.clone(), ..base };
-                let (f2, g2) = refit_candidate(&prob, c, &base, &[*g], POLISH_ITERATIONS)?;
+                let (f2, g2) = refit_candidate(&prob, c, &base, &[(*g, None)], POLISH_ITERATIONS)?;
                 let better = if f2.train_mse < f.train_mse { (f2, g2) } else { (f.clone(), *g) };
                 Some((*k, better.0.clone(), bic_ref - bic(&better.0), better.1))
             })
@@ -471,7 +474,7 @@ fn refit_candidate(
     prob: &Problem<'_>,
     c: &Candidate,
     current: &Fitted,
-    starts: &[f64],
+    starts: &[Start],
     iterations: usize,
 ) -> Option<(Fitted, f64)> {
     let build = |g: f64| {
@@ -482,21 +485,27 @@ fn refit_candidate(
     let hi = c.grid.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     starts
         .iter()
-        .filter_map(|&g| {
+        .filter_map(|(g, theta)| {
+            let g = *g;
+            let theta = theta.as_deref().unwrap_or(&current.theta);
             if c.grid.len() > 1 {
                 let tune = Tune { build: &build, start: g, lo, hi, log: lo > 0.0 };
-                prob.refit(&current.transforms, &current.terms, Some(&tune), &current.theta, iterations)
+                prob.refit(&current.transforms, &current.terms, Some(&tune), theta, iterations)
             } else {
                 let (t, extra) = build(g);
                 let mut transforms = current.transforms.clone();
                 transforms.extend(t);
                 let mut terms = current.terms.clone();
                 terms.extend(extra);
-                prob.refit(&transforms, &terms, None, &current.theta, iterations).map(|r| (r.0, g))
+                prob.refit(&transforms, &terms, None, theta, iterations).map(|r| (r.0, g))
             }
         })
         .min_by(|a, b| a.0.train_mse.total_cmp(&b.0.train_mse))
 }
+
+/// A starting value of a candidate's refit, with the base parameters θ to start from
+/// (`None`: the current model's).
+type Start = (f64, Option<Vec<f64>>);
 
 /// Zero the energy outside `rows`.
 fn mask(e: &mut [f64], rows: &[usize]) {
@@ -517,7 +526,7 @@ fn mask(e: &mut [f64], rows: &[usize]) {
 /// training cost (refined by a parabola through its neighbours on the grid) and, when the
 /// cost has another local minimum on the grid, the best of those (a base model can absorb
 /// part of an effect, which shifts the linearised minimum; the refit decides).
-fn starts_on_grid(prob: &Problem<'_>, c: &Candidate, current: &Fitted, jac: &[Vec<f64>]) -> Vec<f64> {
+fn starts_on_grid(prob: &Problem<'_>, c: &Candidate, current: &Fitted, jac: &[Vec<f64>]) -> Vec<Start> {
     let cost_at = |g: f64| -> Option<f64> {
         let piece = (c.build)(g);
         let mut transforms = current.transforms.clone();
@@ -527,14 +536,15 @@ fn starts_on_grid(prob: &Problem<'_>, c: &Candidate, current: &Fitted, jac: &[Ve
         prob.scan_cost(&transforms, &terms, &current.theta, jac)
     };
     if c.grid.len() < 2 {
-        return c.grid.clone();
+        return c.grid.iter().map(|&g| (g, None)).collect();
     }
     // A transform of the input moves the base model's optimum far (its rate term absorbs
-    // part of a delay or a lag): the linearisation cannot follow, so the cost at a coarse
-    // subset of the grid comes from a short refit of θ instead.
+    // part of a delay or a lag): the linearisation cannot follow, so the cost at a subset of
+    // the grid comes from a short refit of θ instead, walked outward from the identity so
+    // that each refit starts from its neighbour's θ (a continuation: a refit from the
+    // untransformed θ does not converge for a large delay, and its cost would rank a small
+    // one first).
     if c.grid.first().is_some_and(|&g| (c.build)(g).transform.is_some()) {
-        let step = c.grid.len().div_ceil(PROFILE_POINTS).max(1);
-        let coarse: Vec<f64> = c.grid.iter().copied().step_by(step).collect();
         // The first PROFILE_SAMPLES of the training part rank the grid values.
         let short = Problem {
             data: prob.data,
@@ -544,26 +554,39 @@ fn starts_on_grid(prob: &Problem<'_>, c: &Candidate, current: &Fitted, jac: &[Ve
             train: prob.train.iter().copied().take_while(|&i| i < PROFILE_SAMPLES).collect(),
         };
         let prob = if short.train.len() >= 1000 { &short } else { prob };
-        let costs: Vec<f64> = coarse
+        let profile: Vec<(f64, f64, Option<Vec<f64>>)> = continuation_chains(c, &prob.data.input, prob.data.dt)
             .par_iter()
-            .map(|&g| {
-                let piece = (c.build)(g);
-                let mut transforms = current.transforms.clone();
-                transforms.extend(piece.transform);
-                let mut terms = current.terms.clone();
-                terms.extend(piece.terms);
-                prob.refit(&transforms, &terms, None, &current.theta, PROFILE_ITERATIONS)
-                    .map_or(f64::INFINITY, |r| r.0.train_mse)
+            .flat_map_iter(|chain| {
+                let mut theta = current.theta.clone();
+                let mut out = Vec::with_capacity(chain.len());
+                for &g in chain {
+                    let piece = (c.build)(g);
+                    let mut transforms = current.transforms.clone();
+                    transforms.extend(piece.transform);
+                    let mut terms = current.terms.clone();
+                    terms.extend(piece.terms);
+                    match prob.refit(&transforms, &terms, None, &theta, PROFILE_ITERATIONS) {
+                        Some((f, _)) => {
+                            out.push((g, f.train_mse, Some(f.theta.clone())));
+                            theta = f.theta;
+                        }
+                        None => out.push((g, f64::INFINITY, None)),
+                    }
+                }
+                out
             })
             .collect();
-        let mut order: Vec<usize> = (0..coarse.len()).filter(|&k| costs[k].is_finite()).collect();
-        order.sort_by(|&a, &b| costs[a].total_cmp(&costs[b]));
-        let mut out: Vec<f64> = order.first().map(|&k| coarse[k]).into_iter().collect();
-        if let (Some(&a), Some(&b)) =
-            (order.first(), order.iter().find(|&&j| order.first().is_some_and(|&a| j.abs_diff(a) > 1)))
-        {
-            let _ = a;
-            out.push(coarse[b]);
+        let mut order: Vec<usize> = (0..profile.len()).filter(|&k| profile[k].1.is_finite()).collect();
+        order.sort_by(|&a, &b| profile[a].1.total_cmp(&profile[b].1));
+        // The best value, and the best one that is not next to it on the grid (another basin).
+        let gap = |a: f64, b: f64| c.grid.iter().filter(|&&g| (g - a) * (g - b) < 0.0).count() > PROFILE_GAP;
+        // Each start carries the θ its profile refit reached.
+        let mut out: Vec<Start> = Vec::new();
+        if let Some(&a) = order.first() {
+            out.push((profile[a].0, profile[a].2.clone()));
+            if let Some(&b) = order.iter().find(|&&j| gap(profile[a].0, profile[j].0)) {
+                out.push((profile[b].0, profile[b].2.clone()));
+            }
         }
         return out;
     }
@@ -588,7 +611,7 @@ fn starts_on_grid(prob: &Problem<'_>, c: &Candidate, current: &Fitted, jac: &[Ve
             }
         }
     }
-    let mut out = vec![best.0];
+    let mut out = vec![(best.0, None)];
     let local_min = |j: usize| {
         let l = if j > 0 { costs[j - 1] } else { f64::INFINITY };
         let r = costs.get(j + 1).copied().unwrap_or(f64::INFINITY);
@@ -599,9 +622,32 @@ fn starts_on_grid(prob: &Problem<'_>, c: &Candidate, current: &Fitted, jac: &[Ve
         .filter(|&j| j.abs_diff(k) > 1 && local_min(j))
         .min_by(|&a, &b| costs[a].total_cmp(&costs[b]))
     {
-        out.push(c.grid[j]);
+        out.push((c.grid[j], None));
     }
     out
+}
+
+/// The grid of an input-transform candidate as chains walked outward from the identity:
+/// values split by sign (a delay or an offset either way; a lag or a saturation level has
+/// one sign) and each side ordered by how far the transform moves the input, thinned to
+/// [`PROFILE_POINTS`].
+fn continuation_chains(c: &Candidate, x: &[f64], dt: f64) -> Vec<Vec<f64>> {
+    let distance = |g: f64| -> f64 {
+        let Some(t) = (c.build)(g).transform else { return f64::INFINITY };
+        let y = t.apply(x, dt);
+        x.iter().zip(&y).map(|(a, b)| (a - b) * (a - b)).sum::<f64>()
+    };
+    [false, true]
+        .iter()
+        .filter_map(|&negative| {
+            let mut side: Vec<(f64, f64)> =
+                c.grid.iter().filter(|&&g| (g < 0.0) == negative).map(|&g| (distance(g), g)).collect();
+            side.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let step = side.len().div_ceil(PROFILE_POINTS).max(1);
+            let chain: Vec<f64> = side.iter().step_by(step).map(|p| p.1).collect();
+            (!chain.is_empty()).then_some(chain)
+        })
+        .collect()
 }
 
 /// A finding's text, values, windows and conditions.
