@@ -61,7 +61,10 @@ fn run(effect: &str, base: &str, excitation: &str, seed: u64) -> Outcome {
     let g = generate(&spec).unwrap_or_else(|e| panic!("{effect}/{base}/{excitation}: {e}"));
     let rec = Recording::parse_csv(Path::new("concealed.csv"), g.csv.as_bytes()).expect("csv");
     let ch = Channels::default();
-    let data = Dataset::new(&rec, &ch, 0.7, None).expect("dataset");
+    // As `hil-sim diagnose` does: samples the quality check flags (a clipped torque, a
+    // standstill) are left out of the fit and the scores.
+    let excluded = hil_sim::quality::check(&rec, &ch).expect("quality check").excluded();
+    let data = Dataset::new(&rec, &ch, 0.7, Some(excluded)).expect("dataset");
     let aux: Vec<(String, Vec<f64>)> =
         rec.auxiliary(&ch).into_iter().map(|n| (n.to_owned(), rec.channel(n).unwrap().to_vec())).collect();
     let opts = DiagnoseOptions { model: Some(base.into()), ..DiagnoseOptions::default() };
