@@ -398,7 +398,7 @@ pub struct Coeffs {
     /// Largest |duty|, PWM counts for duty 1.
     pub duty_max: f32,
     pub pwm_counts: f32,
-    /// Demagnetising pulse: duty, samples, arming threshold and its quarter.
+    /// Demagnetising pulse: duty, samples, arming threshold.
     pub demag_duty: f32,
     pub demag_samples: u16,
     pub demag_threshold: f32,

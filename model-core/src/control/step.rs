@@ -28,7 +28,7 @@ use super::feedforward::{chord_step, inverse_slope, static_output, StaticMap};
 use super::pi::{clamp, step_limited, PiState};
 use super::pwm::{quantise, Demag, DemagState};
 use super::supervisor::{
-    self, confirm, fast_any, fast_any_clamped, fast_code, Fast, FaultCode, SampleLog, SupState, SLOW_LATCHED,
+    self, confirm, fast_any, fast_any_with, fast_code, Fast, FaultCode, SampleLog, SupState, SLOW_LATCHED,
 };
 use crate::rate::RateParams;
 use crate::{Estimator, EstimatorState, Model, ParamError};
@@ -384,9 +384,9 @@ impl<M: Model> ControlStep<M> {
 
         // A supply outside its window (NaN: v_min) trips within `confirm` samples; until
         // then the duty is computed for the nearest value inside it.
-        let supply = clamp(x.supply_v, k.v_min, k.v_max);
+        let (supply, supply_bad) = supervisor::supply_window(k, x.supply_v);
         let f = Fast { hall: x.hall, i, supply_v: x.supply_v, overrun: x.overrun, model_bad };
-        let fast = confirm(k, &mut s.sup, fast_any_clamped(k, &f, supply));
+        let fast = confirm(k, &mut s.sup, fast_any_with(k, &f, supply_bad));
         let slow = n > k.slow_timeout;
         if fast | slow {
             return tripped(k, s, x, b, i);
@@ -395,23 +395,15 @@ impl<M: Model> ControlStep<M> {
         let mut fl = if model_bad { flags::ESTIMATE_HELD } else { 0 };
         let scale = s.temp_scale;
         let t_est = finite_or(est.y * scale, 0.0);
-        // Reference limited; NaN → 0. This is `math::clamp_symmetric` written out: calling
-        // it here compiled to 3 more instructions on this path (budget bench, 2026-11-22).
+        // Reference limited to ±ref_lim, NaN → 0 (`math::clamp_symmetric`, with the flag set
+        // in its out-of-range branch).
         let (r0, lim) = (x.reference, k.ref_lim);
-        let r = if r0 >= -lim {
-            if r0 <= lim {
-                r0
-            } else {
-                lim
-            }
-        } else if r0 < -lim {
-            -lim
+        let r = if crate::math::abs(r0) <= lim {
+            r0
         } else {
-            0.0
-        };
-        if r != r0 {
             fl |= flags::REFERENCE_LIMITED;
-        }
+            crate::math::limit_sign(r0, lim)
+        };
         let i_ref = match k.mode {
             LoopMode::Torque => {
                 let (model, ms) = (&self.est.model, &s.est.model);
