@@ -288,13 +288,13 @@ impl<M: Model> ControlStep<M> {
         if s.mode == Mode::Running && x.enable {
             self.run(cfg, s, &x)
         } else {
-            self.other(cfg, s, &x)
+            Self::other(cfg, s, &x)
         }
     }
 
     /// Every mode but an enabled `Running`.
-    #[inline(never)]
-    fn other(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: &ControlInput) -> ControlOutput {
+    #[inline(always)]
+    fn other(cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: &ControlInput) -> ControlOutput {
         let (c, k) = (cfg.get(), cfg.coeffs());
         s.sup.since_slow = s.sup.since_slow.wrapping_add(1);
         if !s.calibrated {
@@ -368,7 +368,7 @@ impl<M: Model> ControlStep<M> {
     }
 
     /// The loop closed: estimate, supervise, feed-forward, two PIs, duty.
-    #[inline(never)]
+    #[inline(always)]
     fn run(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: &ControlInput) -> ControlOutput {
         let k = cfg.coeffs();
         let n = s.sup.since_slow.wrapping_add(1);
