@@ -24,7 +24,7 @@
 
 use super::calibration::{counts_to_units, CalibResult, CalibState, Calibration};
 use super::config::{Coeffs, LoopMode, ValidatedConfig};
-use super::feedforward::{chord_step, inverse_slope, static_output, StaticMap};
+use super::feedforward::{static_output, Linear, StaticMap};
 use super::pi::{clamp, step_limited, PiState};
 use super::pwm::{quantise, Demag, DemagState};
 use super::supervisor::{
@@ -126,19 +126,19 @@ pub struct ControlState<S> {
     pub demag: DemagState,
     /// Voltage commanded on the previous sample, V.
     pub last_v: f32,
-    /// Previous feed-forward flux density (Newton start, in `[0, b_max − h]`), T, and
-    /// current, A.
-    pub b_star: f32,
-    pub i_ff: f32,
+    /// The feed-forward map (set by the slow pass) and the reference (N·m, at least the
+    /// torque floor) of the last running sample: the lead's previous value and where the
+    /// slow pass moves the map's operating point.
+    pub ff: Linear,
+    pub r_last: f32,
     /// Temperature compensation factor of the estimate (1: none), set by the slow pass
     /// (which runs before the loop starts).
     pub temp_scale: f32,
     /// Coil current of the last running sample, A. The slow pass takes the model's static
-    /// part there: its torque at B = 0 (the floor of the reachable torque, N·m) and its
-    /// reciprocal slope at `b_star` (T per N·m) for the feed-forward's chord steps.
+    /// part there: its torque at B = 0 (the floor of the reachable torque, N·m) and the
+    /// feed-forward map.
     pub last_i: f32,
     pub t_floor: f32,
-    pub ff_inv_slope: f32,
 }
 
 impl<S: Default> ControlState<S> {
@@ -159,12 +159,11 @@ impl<S: Default> ControlState<S> {
         // (re)started (`SupState::log_start`), and clearing 512 B would double this call.
         self.demag = DemagState::default();
         self.last_v = 0.0;
-        self.b_star = 0.0;
-        self.i_ff = 0.0;
+        self.ff = Linear::default();
+        self.r_last = 0.0;
         self.temp_scale = 0.0;
         self.last_i = 0.0;
         self.t_floor = 0.0;
-        self.ff_inv_slope = 0.0;
     }
 }
 
@@ -273,7 +272,7 @@ impl<M: Model> ControlStep<M> {
         let (model, ms, i) = (&self.est.model, &s.est.model, s.last_i);
         let t_static = |bb: f32| static_output(model, ms, bb, i) * scale;
         s.t_floor = finite_or(t_static(0.0), 0.0);
-        s.ff_inv_slope = inverse_slope(t_static, s.b_star, cfg.coeffs().ff_h);
+        s.ff.update(t_static, s.r_last, cfg.coeffs());
         s.sup.since_slow = if s.sup.slow_fault == FaultCode::None { 0 } else { SLOW_LATCHED };
         s.sup.log_start = 0;
         s.sup.slow_seen = true;
@@ -406,18 +405,15 @@ impl<M: Model> ControlStep<M> {
         };
         let i_ref = match k.mode {
             LoopMode::Torque => {
-                let (model, ms) = (&self.est.model, &s.est.model);
-                let t_static = |bb: f32| static_output(model, ms, bb, i) * scale;
                 // Below the torque at B = 0 (from the slow pass) nothing can be reached:
                 // aim there.
                 let t0 = s.t_floor;
                 let r_eff = if t0 > r { t0 } else { r };
-                // One chord step per sample from the last solution (slope from the slow pass).
-                let b_star = chord_step(t_static, r_eff, s.b_star, s.ff_inv_slope, k.ff_hi, k.ff_step);
-                s.b_star = b_star;
-                let i_ff = b_star * k.amp_per_b;
-                let ff = clamp(i_ff + k.lead * (i_ff - s.i_ff), 0.0, k.i_max);
-                s.i_ff = i_ff;
+                // The lead acts on the reference, ahead of the feed-forward's affine map
+                // (the same as on its current while the map holds).
+                let r_lead = r_eff + k.lead * (r_eff - s.r_last);
+                s.r_last = r_eff;
+                let ff = s.ff.current(r_lead);
                 step_limited(k.kp_t, k.ki_t_dt, &mut s.pi_t, r_eff - t_est, ff, 0.0, k.i_max)
             }
             LoopMode::OpenLoopTorque => StaticMap { a: cfg.get().map }.current(r, k.i_max),
