@@ -28,7 +28,7 @@ use super::feedforward::{static_output, Linear, StaticMap};
 use super::pi::{clamp, step_limited, PiState};
 use super::pwm::{quantise, Demag, DemagState};
 use super::supervisor::{
-    self, confirm, fast_any, fast_any_with, fast_code, Fast, FaultCode, SampleLog, SupState, SLOW_LATCHED,
+    self, confirm, fast_any, fast_any_with, Fast, FaultCode, SampleLog, SupState, SLOW_LATCHED,
 };
 use crate::rate::RateParams;
 use crate::{Estimator, EstimatorState, Model, ParamError};
@@ -338,7 +338,8 @@ impl<M: Model> ControlStep<M> {
             Mode::Calibrating => {
                 let f = Fast { hall: x.hall, i, supply_v: x.supply_v, overrun: x.overrun, model_bad: false };
                 if confirm(k, &mut s.sup, fast_any(k, &f)) {
-                    return trip(s, b, i, fast_code(k, &f));
+                    // The slow verdict is `None` here (tested above): the fast code.
+                    return tripped(k, s, x, b, i);
                 }
                 let cal = Calibration {
                     samples: c.calib_samples as u16,
