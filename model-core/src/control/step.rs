@@ -9,13 +9,16 @@
 //! Two entry points:
 //! - [`ControlStep::step`], every sample (20 kHz): cannot fail, allocates nothing and never
 //!   emits NaN: every output field is finite for any input. Its hot path (loop closed)
-//!   is straight-line code with no division by a setting; the other modes take a separate,
-//!   equally bounded path.
+//!   is straight-line code with no division by a setting and no model evaluation but the
+//!   estimate; the other modes take a separate, equally bounded path. The current loop
+//!   runs every sample; the torque loop at half the rate, in two phases on alternate
+//!   samples (the feed-forward, then the PI), its current reference held in between.
 //! - [`ControlStep::slow`], about 1 kHz from a lower-priority task: the checks that need
 //!   not run every sample (configuration fingerprint and coefficients, model/configuration
 //!   time step, and the slow-developing supervisor checks — Hall noise, stuck Hall, coil
 //!   open, B/i band — replayed from the [`SampleLog`] the step writes, a few instructions
-//!   a sample) and the temperature compensation. A fault it finds is latched and trips
+//!   a sample), the temperature compensation and the feed-forward's linearisation
+//!   ([`Linear`]: operating point, static torque and slope). A fault it finds is latched and trips
 //!   the next sample, so a slow-developing fault trips within its own sample count plus
 //!   one slow period plus one sample (at 20 kHz with the 1 kHz pass: ≤ 21 samples later
 //!   than when it was judged every sample); a step that sees no slow pass for
@@ -27,9 +30,7 @@ use super::config::{Coeffs, LoopMode, ValidatedConfig};
 use super::feedforward::{static_output, Linear, StaticMap};
 use super::pi::{clamp, step_limited, PiState};
 use super::pwm::{quantise, Demag, DemagState};
-use super::supervisor::{
-    self, confirm, fast_any, fast_any_with, Fast, FaultCode, SampleLog, SupState, SLOW_LATCHED,
-};
+use super::supervisor::{self, confirm, fast_any, fast_any_with, Fast, FaultCode, SampleLog, SupState, SLOW_LATCHED};
 use crate::rate::RateParams;
 use crate::{Estimator, EstimatorState, Model, ParamError};
 
@@ -127,10 +128,17 @@ pub struct ControlState<S> {
     /// Voltage commanded on the previous sample, V.
     pub last_v: f32,
     /// The feed-forward map (set by the slow pass) and the reference (N·m, at least the
-    /// torque floor) of the last running sample: the lead's previous value and where the
-    /// slow pass moves the map's operating point.
+    /// torque floor) of the torque loop's last feed-forward phase: the lead's previous
+    /// value, the PI phase's reference and where the slow pass moves the map's operating
+    /// point.
     pub ff: Linear,
     pub r_last: f32,
+    /// Torque loop: this sample is its PI phase (it alternates with the feed-forward
+    /// phase), the feed-forward current of the last feed-forward phase (A) and the current
+    /// reference of the last PI phase (A), held in between.
+    pub pi_phase: bool,
+    pub ff_i: f32,
+    pub i_ref: f32,
     /// Temperature compensation factor of the estimate (1: none), set by the slow pass
     /// (which runs before the loop starts).
     pub temp_scale: f32,
@@ -161,6 +169,9 @@ impl<S: Default> ControlState<S> {
         self.last_v = 0.0;
         self.ff = Linear::default();
         self.r_last = 0.0;
+        self.pi_phase = false;
+        self.ff_i = 0.0;
+        self.i_ref = 0.0;
         self.temp_scale = 0.0;
         self.last_i = 0.0;
         self.t_floor = 0.0;
@@ -280,8 +291,9 @@ impl<M: Model> ControlStep<M> {
 
     /// Process one sample. See the module documentation.
     ///
-    /// A thin dispatcher: the loop-closed path and every other mode are separate functions,
-    /// so neither pays for the other's stack frame.
+    /// The loop-closed path and every other mode are inlined here, one frame for both (a
+    /// call from a dispatcher would cost another frame and the argument shuffle; the
+    /// frame is the larger path's, 112 B).
     #[inline]
     pub fn step(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: ControlInput) -> ControlOutput {
         if s.mode == Mode::Running && x.enable {
@@ -332,6 +344,7 @@ impl<M: Model> ControlStep<M> {
             Mode::Calibrating | Mode::Running if !x.enable => {
                 s.pi_i = PiState::default();
                 s.pi_t = PiState::default();
+                s.i_ref = 0.0;
                 s.last_v = 0.0;
                 Mode::Disabled
             }
@@ -406,16 +419,25 @@ impl<M: Model> ControlStep<M> {
         };
         let i_ref = match k.mode {
             LoopMode::Torque => {
-                // Below the torque at B = 0 (from the slow pass) nothing can be reached:
-                // aim there.
-                let t0 = s.t_floor;
-                let r_eff = if t0 > r { t0 } else { r };
-                // The lead acts on the reference, ahead of the feed-forward's affine map
-                // (the same as on its current while the map holds).
-                let r_lead = r_eff + k.lead * (r_eff - s.r_last);
-                s.r_last = r_eff;
-                let ff = s.ff.current(r_lead);
-                step_limited(k.kp_t, k.ki_t_dt, &mut s.pi_t, r_eff - t_est, ff, 0.0, k.i_max)
+                // The torque loop runs at half the sample rate in two phases on alternate
+                // samples, the current loop below every sample: the feed-forward, then
+                // the PI on it and on this sample's estimate; its output is held between.
+                s.pi_phase = !s.pi_phase;
+                if s.pi_phase {
+                    let e = s.r_last - t_est;
+                    s.i_ref = step_limited(k.kp_t, k.ki_t_dt, &mut s.pi_t, e, s.ff_i, 0.0, k.i_max);
+                } else {
+                    // Below the torque at B = 0 (from the slow pass) nothing can be
+                    // reached: aim there.
+                    let t0 = s.t_floor;
+                    let r_eff = if t0 > r { t0 } else { r };
+                    // The lead acts on the reference, ahead of the feed-forward's affine
+                    // map (the same as on its current while the map holds).
+                    let r_lead = r_eff + k.lead * (r_eff - s.r_last);
+                    s.r_last = r_eff;
+                    s.ff_i = s.ff.current(r_lead);
+                }
+                s.i_ref
             }
             LoopMode::OpenLoopTorque => StaticMap { a: cfg.get().map }.current(r, k.i_max),
             LoopMode::Current => r,
