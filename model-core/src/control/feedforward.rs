@@ -165,6 +165,7 @@ impl StaticMap {
     }
 
     /// Current in `[0, i_max]` for torque `t`.
+    #[cold]
     #[inline(never)]
     pub fn current(&self, t: f32, i_max: f32) -> f32 {
         invert(|i| self.torque(i), t, 0.5 * i_max, 0.0, i_max, 8, 1e-3 * i_max)
