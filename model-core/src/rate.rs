@@ -18,11 +18,12 @@ use crate::error::{check, time_step};
 use crate::math::exp;
 use crate::ParamError;
 
-/// Validated estimator coefficients for one time step.
+/// Validated estimator coefficients for one time step (`Filtered`: `a` the pole, `g = 1 − a`
+/// the gain, stored so that a sample needs no subtraction).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RateParams {
     Backward { inv_dt: f32 },
-    Filtered { inv_dt: f32, a: f32 },
+    Filtered { inv_dt: f32, a: f32, g: f32 },
     Kalman { dt: f32, gain: [f32; 3] },
 }
 
@@ -57,7 +58,7 @@ impl RateParams {
         let dt = time_step(dt)?;
         let fc = check("fc", fc, f32::MIN_POSITIVE, 0.5 / dt)?;
         let a = exp(-2.0 * core::f32::consts::PI * fc * dt);
-        Ok(Self::Filtered { inv_dt: 1.0 / dt, a })
+        Ok(Self::Filtered { inv_dt: 1.0 / dt, a, g: 1.0 - a })
     }
 
     /// Steady-state constant-acceleration Kalman filter (seed 002 eq. 19–27) with jerk
@@ -87,11 +88,11 @@ impl RateParams {
                 *s = RateState { x, dx, ddx, primed: 2 };
                 (dx, ddx)
             }
-            Self::Filtered { inv_dt, a } => {
+            Self::Filtered { inv_dt, a, g } => {
                 let raw = (x - s.x) * inv_dt;
-                let dx = if s.primed >= 2 { a * s.dx + (1.0 - a) * raw } else { raw };
+                let dx = if s.primed >= 2 { a * s.dx + g * raw } else { raw };
                 let raw2 = if s.primed >= 2 { (dx - s.dx) * inv_dt } else { 0.0 };
-                let ddx = a * s.ddx + (1.0 - a) * raw2;
+                let ddx = a * s.ddx + g * raw2;
                 *s = RateState { x, dx, ddx, primed: 2 };
                 (dx, ddx)
             }
@@ -116,7 +117,7 @@ impl RateParams {
     pub fn delay_s(&self) -> f32 {
         match *self {
             Self::Backward { inv_dt } => 0.5 / inv_dt,
-            Self::Filtered { inv_dt, a } => 0.5 / inv_dt + a / ((1.0 - a) * inv_dt),
+            Self::Filtered { inv_dt, a, g } => 0.5 / inv_dt + a / (g * inv_dt),
             // Steady-state CA Kalman filter is unbiased for polynomial inputs up to degree 2.
             Self::Kalman { .. } => 0.0,
         }

@@ -377,7 +377,8 @@ pub struct Coeffs {
     /// Plausibility band, T (`+∞`: disabled), and the B/i slope, T/A.
     pub b_band: f32,
     pub b_per_amp: f32,
-    /// `1/b_per_amp`, A/T; current lead `ff_lead_s/dt` (1).
+    /// `1/b_per_amp`, A/T; the feed-forward's lead per torque-loop update (two samples),
+    /// `ff_lead_s/(2·dt)` (1).
     pub amp_per_b: f32,
     pub lead: f32,
     /// Feed-forward: the range of B* (`[0, b_max − h]`, T), the forward-difference width
@@ -388,7 +389,8 @@ pub struct Coeffs {
     /// Reference limit (N·m, or A in current mode) and the current limit, A.
     pub ref_lim: f32,
     pub i_max: f32,
-    /// Torque PI: A/(N·m), A/(N·m) per sample; current PI: V/A, V/A per sample.
+    /// Torque PI: A/(N·m), A/(N·m) per update (the torque loop runs every second sample:
+    /// `ki_t·2·dt`); current PI: V/A, V/A per sample.
     pub kp_t: f32,
     pub ki_t_dt: f32,
     pub kp_i: f32,
@@ -398,7 +400,7 @@ pub struct Coeffs {
     /// Largest |duty|, PWM counts for duty 1.
     pub duty_max: f32,
     pub pwm_counts: f32,
-    /// Demagnetising pulse: duty, samples, arming threshold and its quarter.
+    /// Demagnetising pulse: duty, samples, arming threshold.
     pub demag_duty: f32,
     pub demag_samples: u16,
     pub demag_threshold: f32,
@@ -438,14 +440,14 @@ impl Coeffs {
             b_band: if c.b_band > 0.0 { c.b_band } else { f32::INFINITY },
             b_per_amp: c.b_per_amp,
             amp_per_b: 1.0 / c.b_per_amp,
-            lead: c.ff_lead_s / c.dt,
+            lead: c.ff_lead_s / (2.0 * c.dt),
             ff_hi: c.b_max - h,
             ff_h: h,
             ff_step: 0.25 * c.b_max,
             ref_lim: if c.mode == LoopMode::Current { c.i_max } else { c.torque_max },
             i_max: c.i_max,
             kp_t: c.kp_t,
-            ki_t_dt: c.ki_t * c.dt,
+            ki_t_dt: c.ki_t * (2.0 * c.dt),
             kp_i: c.kp_i,
             ki_i_dt: c.ki_i * c.dt,
             coil_r: c.coil_r,

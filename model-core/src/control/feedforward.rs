@@ -4,7 +4,13 @@
 //! Used for the inverse of the model's static part (`B*` with `T_static(B*) = T_ref`,
 //! where `T_static` is the model evaluated at `Ḃ = 0` from its present state) and for the
 //! baseline's static current → torque map.
+//!
+//! The control step's feed-forward is [`Linear`]: the inverse linearised around its
+//! operating point by the slow pass (about 1 kHz: one chord step of the operating point
+//! towards the latest reference, the static torque and its slope there), applied per
+//! sample as an affine map of the reference with one limit.
 
+use super::config::Coeffs;
 use super::pi::clamp;
 use crate::{Kin, Model};
 
@@ -37,11 +43,17 @@ pub fn invert<F: Fn(f32) -> f32>(f: F, target: f32, x0: f32, lo: f32, hi: f32, i
 /// finite there (no step).
 #[inline(always)]
 pub fn inverse_slope<F: Fn(f32) -> f32>(f: F, x: f32, h: f32) -> f32 {
-    let den = f(x + h) - f(x);
-    // `den − den` is 0 exactly when `den` is finite (one subtraction and a compare).
+    inverse_of_rise(f(x + h) - f(x), h)
+}
+
+/// `h/rise` for a finite `rise` (`±∞` for 0), else 0: [`inverse_slope`] from its
+/// difference.
+#[inline(always)]
+fn inverse_of_rise(rise: f32, h: f32) -> f32 {
+    // `rise − rise` is 0 exactly when `rise` is finite (one subtraction and a compare).
     #[allow(clippy::eq_op)]
-    if den - den == 0.0 {
-        h / den
+    if rise - rise == 0.0 {
+        h / rise
     } else {
         0.0
     }
@@ -51,11 +63,16 @@ pub fn inverse_slope<F: Fn(f32) -> f32>(f: F, x: f32, h: f32) -> f32 {
 /// `inv_slope` ([`inverse_slope`], taken now or a little earlier): Newton's method with a
 /// lagged derivative, one evaluation of `f` and no division. The step is limited to
 /// `±max_step`; a non-finite quotient (an infinite or NaN `f`) leaves `x`. The result is
-/// in `[0, hi]` for a finite `x`. The per-sample feed-forward: the reference moves little
-/// in one period, so one step from the last solution tracks the root.
+/// in `[0, hi]` for a finite `x`.
 #[inline(always)]
 pub fn chord_step<F: Fn(f32) -> f32>(f: F, target: f32, x: f32, inv_slope: f32, hi: f32, max_step: f32) -> f32 {
-    let q = (target - f(x)) * inv_slope;
+    chord_from(f(x), target, x, inv_slope, hi, max_step)
+}
+
+/// [`chord_step`] with `f(x)` given (`fx`).
+#[inline(always)]
+fn chord_from(fx: f32, target: f32, x: f32, inv_slope: f32, hi: f32, max_step: f32) -> f32 {
+    let q = (target - fx) * inv_slope;
     // NaN → no step.
     let dx = crate::math::clamp_symmetric(q, max_step);
     clamp(x + dx, 0.0, hi)
@@ -66,6 +83,61 @@ pub fn chord_step<F: Fn(f32) -> f32>(f: F, target: f32, x: f32, inv_slope: f32, 
 #[inline(always)]
 pub fn newton_step<F: Fn(f32) -> f32>(f: F, target: f32, x: f32, hi: f32, h: f32, max_step: f32) -> f32 {
     chord_step(&f, target, x, inverse_slope(&f, x, h), hi, max_step)
+}
+
+/// The feed-forward current as an affine map of the torque reference, valid near its
+/// operating point: `i = clamp(i0 + (T − t0)·gain, lo, hi)`. Set by [`Linear::update`] (the
+/// slow pass), read every sample by [`Linear::current`] (one multiply-add and one limit,
+/// no model evaluation, no division). Default: 0 A for every reference.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Linear {
+    /// Operating point: flux density B* (T, in `[0, b_max − h]`), the static torque there
+    /// (N·m, finite) and the reciprocal slope `dB/dT` there (T per N·m; 0: no step).
+    pub b0: f32,
+    pub t0: f32,
+    pub inv_slope: f32,
+    /// `b0` as a current (A), the slope as A per N·m (finite), and the limits of the map
+    /// (A): B within one Newton step (`ff_step`) of `b0`, inside `[0, b_max − h]`, as a
+    /// current inside `[0, i_max]`.
+    pub i0: f32,
+    pub gain: f32,
+    pub lo: f32,
+    pub hi: f32,
+}
+
+impl Linear {
+    /// The feed-forward current (A) for torque `t` (N·m, finite): always finite, in
+    /// `[lo, hi]`.
+    #[inline(always)]
+    pub fn current(&self, t: f32) -> f32 {
+        clamp(self.i0 + (t - self.t0) * self.gain, self.lo, self.hi)
+    }
+
+    /// Move the operating point one chord step (limited to `ff_step`, inside
+    /// `[0, ff_hi]`) towards `target` (N·m, finite) with the present reciprocal slope,
+    /// i.e. to where the map puts `target`, and take the static torque `f` and its slope
+    /// there (forward difference of width `ff_h`). A non-finite `f` there leaves no slope
+    /// (the map is then constant); a flat `f` gives the largest finite gain.
+    pub fn update<F: Fn(f32) -> f32>(&mut self, f: F, target: f32, k: &Coeffs) {
+        let b0 = chord_from(self.t0, target, self.b0, self.inv_slope, k.ff_hi, k.ff_step);
+        let t0 = f(b0);
+        // `t0 − t0` is 0 exactly when `t0` is finite.
+        #[allow(clippy::eq_op)]
+        let (t0, inv_slope) =
+            if t0 - t0 == 0.0 { (t0, inverse_of_rise(f(b0 + k.ff_h) - t0, k.ff_h)) } else { (0.0, 0.0) };
+        let b_lo = if b0 > k.ff_step { b0 - k.ff_step } else { 0.0 };
+        let b_hi = if b0 + k.ff_step < k.ff_hi { b0 + k.ff_step } else { k.ff_hi };
+        *self = Self {
+            b0,
+            t0,
+            inv_slope,
+            i0: b0 * k.amp_per_b,
+            // ±∞ (flat) → ±f32::MAX, so that `(t − t0)·gain` is never NaN.
+            gain: crate::math::clamp_symmetric(inv_slope * k.amp_per_b, f32::MAX),
+            lo: clamp(b_lo * k.amp_per_b, 0.0, k.i_max),
+            hi: clamp(b_hi * k.amp_per_b, 0.0, k.i_max),
+        };
+    }
 }
 
 /// The model's static part at its present state: output for input `x` with zero rate.
@@ -93,6 +165,8 @@ impl StaticMap {
     }
 
     /// Current in `[0, i_max]` for torque `t`.
+    #[cold]
+    #[inline(never)]
     pub fn current(&self, t: f32, i_max: f32) -> f32 {
         invert(|i| self.torque(i), t, 0.5 * i_max, 0.0, i_max, 8, 1e-3 * i_max)
     }
@@ -158,5 +232,42 @@ mod tests {
         assert!(x.is_finite() && (0.0..=3.5).contains(&x));
         let bad = invert(|_| f32::NAN, 1.0, 0.3, 0.0, 1.0, 8, 1e-3);
         assert!((bad - 0.3).abs() < 1e-6);
+    }
+
+    /// The slow pass's updates move the operating point to the inverse of the reference;
+    /// in between, the per-sample map is the static part's tangent there, within its step
+    /// limit and the current limit, and finite for any finite torque.
+    #[test]
+    fn linear_map_tracks_the_inverse_and_stays_bounded() {
+        use crate::control::config::Coeffs;
+        use crate::control::ControlConfig;
+        let m = Algebraic::new(20.0, -0.05, -2.0, 0.8, 1e-4).unwrap();
+        let f = |b: f32| static_output(&m, &(), b, 0.0);
+        let k = Coeffs::new(&ControlConfig::defaults(1e-4));
+        let mut ff = Linear::default();
+        assert_eq!(ff.current(5.0), 0.0, "no map before the first update");
+        for _ in 0..6 {
+            ff.update(f, 6.0, &k);
+        }
+        let b = ff.current(6.0) / k.amp_per_b;
+        assert!((f(b) - 6.0).abs() < 1e-3, "{b}: {}", f(b));
+        // Near the operating point, the tangent: second-order error.
+        let b1 = ff.current(6.2) / k.amp_per_b;
+        assert!((f(b1) - 6.2).abs() < 2e-3, "{b1}: {}", f(b1));
+        // Far from it, the step and current limits.
+        assert!(ff.current(1e9) <= k.i_max && ff.current(1e9) <= (ff.b0 + k.ff_step) * k.amp_per_b + 1e-6);
+        assert!(ff.current(-1e9) >= 0.0 && ff.current(-1e9) >= (ff.b0 - k.ff_step) * k.amp_per_b - 1e-6);
+        // A flat map: the largest finite gain, no NaN at the operating point.
+        let mut flat = Linear::default();
+        flat.update(|_| 2.0, 1.0, &k);
+        for t in [2.0f32, 1.0, 3.0, f32::MAX, -f32::MAX] {
+            let i = flat.current(t);
+            assert!(i.is_finite() && (flat.lo..=flat.hi).contains(&i), "{t}: {i}");
+        }
+        // A non-finite static part: a constant map.
+        let mut bad = ff;
+        bad.update(|_| f32::NAN, 6.0, &k);
+        assert_eq!((bad.gain, bad.t0), (0.0, 0.0));
+        assert_eq!(bad.current(3.0), bad.current(9.0));
     }
 }

@@ -45,34 +45,48 @@ pub struct Demag {
 /// Pulse state.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct DemagState {
-    pub armed: bool,
+    /// Samples of the running pulse still to drive.
     pub remaining: u16,
     /// The current before the pulse, A (its sign sets the pulse's: stored as it is, the
     /// sign is taken only while the pulse runs).
     pub sign: f32,
+    /// |command| below which the pulse fires: a quarter of [`Demag::threshold`] while
+    /// armed, 0 (never, as |command| ≥ 0) otherwise. One compare tests "armed and
+    /// released".
+    pub level: f32,
 }
 
 impl Demag {
-    /// Feed the command and the coil current; `Some(duty)` while the pulse overrides the loop.
+    /// Feed the command and the coil current; `Some(duty)` while the pulse
+    /// overrides the loop.
+    #[inline(always)]
     pub fn step(&self, s: &mut DemagState, command: f32, i: f32) -> Option<f32> {
-        // Against the current before the pulse (0 counts as positive).
-        let pulse = if s.sign < 0.0 { self.duty } else { -self.duty };
         if s.remaining > 0 {
             s.remaining -= 1;
-            return Some(pulse);
+            return Some(self.pulse(s));
         }
         let mag = crate::math::abs(command);
         if mag >= self.threshold {
-            s.armed = true;
+            s.level = 0.25 * self.threshold;
             s.sign = i;
-        } else if s.armed && mag < 0.25 * self.threshold {
-            s.armed = false;
+        } else if mag < s.level {
+            s.level = 0.0;
             if self.samples > 0 {
                 s.remaining = self.samples - 1;
-                return Some(pulse);
+                return Some(self.pulse(s));
             }
         }
         None
+    }
+
+    /// The pulse's duty: against the current before it (0 counts as positive).
+    #[inline(always)]
+    fn pulse(&self, s: &DemagState) -> f32 {
+        if s.sign < 0.0 {
+            self.duty
+        } else {
+            -self.duty
+        }
     }
 }
 

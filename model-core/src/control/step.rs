@@ -9,13 +9,16 @@
 //! Two entry points:
 //! - [`ControlStep::step`], every sample (20 kHz): cannot fail, allocates nothing and never
 //!   emits NaN: every output field is finite for any input. Its hot path (loop closed)
-//!   is straight-line code with no division by a setting; the other modes take a separate,
-//!   equally bounded path.
+//!   is straight-line code with no division by a setting and no model evaluation but the
+//!   estimate; the other modes take a separate, equally bounded path. The current loop
+//!   runs every sample; the torque loop at half the rate, in two phases on alternate
+//!   samples (the feed-forward, then the PI), its current reference held in between.
 //! - [`ControlStep::slow`], about 1 kHz from a lower-priority task: the checks that need
 //!   not run every sample (configuration fingerprint and coefficients, model/configuration
 //!   time step, and the slow-developing supervisor checks — Hall noise, stuck Hall, coil
 //!   open, B/i band — replayed from the [`SampleLog`] the step writes, a few instructions
-//!   a sample) and the temperature compensation. A fault it finds is latched and trips
+//!   a sample), the temperature compensation and the feed-forward's linearisation
+//!   ([`Linear`]: operating point, static torque and slope). A fault it finds is latched and trips
 //!   the next sample, so a slow-developing fault trips within its own sample count plus
 //!   one slow period plus one sample (at 20 kHz with the 1 kHz pass: ≤ 21 samples later
 //!   than when it was judged every sample); a step that sees no slow pass for
@@ -24,12 +27,10 @@
 
 use super::calibration::{counts_to_units, CalibResult, CalibState, Calibration};
 use super::config::{Coeffs, LoopMode, ValidatedConfig};
-use super::feedforward::{chord_step, inverse_slope, static_output, StaticMap};
+use super::feedforward::{static_output, Linear, StaticMap};
 use super::pi::{clamp, step_limited, PiState};
 use super::pwm::{quantise, Demag, DemagState};
-use super::supervisor::{
-    self, confirm, fast_any, fast_any_clamped, fast_code, Fast, FaultCode, SampleLog, SupState, SLOW_LATCHED,
-};
+use super::supervisor::{self, confirm, fast_any, fast_any_with, Fast, FaultCode, SampleLog, SupState, SLOW_LATCHED};
 use crate::rate::RateParams;
 use crate::{Estimator, EstimatorState, Model, ParamError};
 
@@ -126,19 +127,26 @@ pub struct ControlState<S> {
     pub demag: DemagState,
     /// Voltage commanded on the previous sample, V.
     pub last_v: f32,
-    /// Previous feed-forward flux density (Newton start, in `[0, b_max − h]`), T, and
-    /// current, A.
-    pub b_star: f32,
-    pub i_ff: f32,
+    /// The feed-forward map (set by the slow pass) and the reference (N·m, at least the
+    /// torque floor) of the torque loop's last feed-forward phase: the lead's previous
+    /// value, the PI phase's reference and where the slow pass moves the map's operating
+    /// point.
+    pub ff: Linear,
+    pub r_last: f32,
+    /// Torque loop: this sample is its PI phase (it alternates with the feed-forward
+    /// phase), the feed-forward current of the last feed-forward phase (A) and the current
+    /// reference of the last PI phase (A), held in between.
+    pub pi_phase: bool,
+    pub ff_i: f32,
+    pub i_ref: f32,
     /// Temperature compensation factor of the estimate (1: none), set by the slow pass
     /// (which runs before the loop starts).
     pub temp_scale: f32,
     /// Coil current of the last running sample, A. The slow pass takes the model's static
-    /// part there: its torque at B = 0 (the floor of the reachable torque, N·m) and its
-    /// reciprocal slope at `b_star` (T per N·m) for the feed-forward's chord steps.
+    /// part there: its torque at B = 0 (the floor of the reachable torque, N·m) and the
+    /// feed-forward map.
     pub last_i: f32,
     pub t_floor: f32,
-    pub ff_inv_slope: f32,
 }
 
 impl<S: Default> ControlState<S> {
@@ -159,12 +167,14 @@ impl<S: Default> ControlState<S> {
         // (re)started (`SupState::log_start`), and clearing 512 B would double this call.
         self.demag = DemagState::default();
         self.last_v = 0.0;
-        self.b_star = 0.0;
-        self.i_ff = 0.0;
+        self.ff = Linear::default();
+        self.r_last = 0.0;
+        self.pi_phase = false;
+        self.ff_i = 0.0;
+        self.i_ref = 0.0;
         self.temp_scale = 0.0;
         self.last_i = 0.0;
         self.t_floor = 0.0;
-        self.ff_inv_slope = 0.0;
     }
 }
 
@@ -273,7 +283,7 @@ impl<M: Model> ControlStep<M> {
         let (model, ms, i) = (&self.est.model, &s.est.model, s.last_i);
         let t_static = |bb: f32| static_output(model, ms, bb, i) * scale;
         s.t_floor = finite_or(t_static(0.0), 0.0);
-        s.ff_inv_slope = inverse_slope(t_static, s.b_star, cfg.coeffs().ff_h);
+        s.ff.update(t_static, s.r_last, cfg.coeffs());
         s.sup.since_slow = if s.sup.slow_fault == FaultCode::None { 0 } else { SLOW_LATCHED };
         s.sup.log_start = 0;
         s.sup.slow_seen = true;
@@ -281,20 +291,21 @@ impl<M: Model> ControlStep<M> {
 
     /// Process one sample. See the module documentation.
     ///
-    /// A thin dispatcher: the loop-closed path and every other mode are separate functions,
-    /// so neither pays for the other's stack frame.
+    /// The loop-closed path and every other mode are inlined here, one frame for both (a
+    /// call from a dispatcher would cost another frame and the argument shuffle; the
+    /// frame is the larger path's, 112 B).
     #[inline]
     pub fn step(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: ControlInput) -> ControlOutput {
         if s.mode == Mode::Running && x.enable {
             self.run(cfg, s, &x)
         } else {
-            self.other(cfg, s, &x)
+            Self::other(cfg, s, &x)
         }
     }
 
     /// Every mode but an enabled `Running`.
-    #[inline(never)]
-    fn other(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: &ControlInput) -> ControlOutput {
+    #[inline(always)]
+    fn other(cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: &ControlInput) -> ControlOutput {
         let (c, k) = (cfg.get(), cfg.coeffs());
         s.sup.since_slow = s.sup.since_slow.wrapping_add(1);
         if !s.calibrated {
@@ -333,13 +344,15 @@ impl<M: Model> ControlStep<M> {
             Mode::Calibrating | Mode::Running if !x.enable => {
                 s.pi_i = PiState::default();
                 s.pi_t = PiState::default();
+                s.i_ref = 0.0;
                 s.last_v = 0.0;
                 Mode::Disabled
             }
             Mode::Calibrating => {
                 let f = Fast { hall: x.hall, i, supply_v: x.supply_v, overrun: x.overrun, model_bad: false };
                 if confirm(k, &mut s.sup, fast_any(k, &f)) {
-                    return trip(s, b, i, fast_code(k, &f));
+                    // The slow verdict is `None` here (tested above): the fast code.
+                    return tripped(k, s, x, b, i);
                 }
                 let cal = Calibration {
                     samples: c.calib_samples as u16,
@@ -368,7 +381,7 @@ impl<M: Model> ControlStep<M> {
     }
 
     /// The loop closed: estimate, supervise, feed-forward, two PIs, duty.
-    #[inline(never)]
+    #[inline(always)]
     fn run(&self, cfg: &ValidatedConfig, s: &mut ControlState<M::State>, x: &ControlInput) -> ControlOutput {
         let k = cfg.coeffs();
         let n = s.sup.since_slow.wrapping_add(1);
@@ -384,9 +397,9 @@ impl<M: Model> ControlStep<M> {
 
         // A supply outside its window (NaN: v_min) trips within `confirm` samples; until
         // then the duty is computed for the nearest value inside it.
-        let supply = clamp(x.supply_v, k.v_min, k.v_max);
+        let (supply, supply_bad) = supervisor::supply_window(k, x.supply_v);
         let f = Fast { hall: x.hall, i, supply_v: x.supply_v, overrun: x.overrun, model_bad };
-        let fast = confirm(k, &mut s.sup, fast_any_clamped(k, &f, supply));
+        let fast = confirm(k, &mut s.sup, fast_any_with(k, &f, supply_bad));
         let slow = n > k.slow_timeout;
         if fast | slow {
             return tripped(k, s, x, b, i);
@@ -395,38 +408,36 @@ impl<M: Model> ControlStep<M> {
         let mut fl = if model_bad { flags::ESTIMATE_HELD } else { 0 };
         let scale = s.temp_scale;
         let t_est = finite_or(est.y * scale, 0.0);
-        // Reference limited; NaN → 0. This is `math::clamp_symmetric` written out: calling
-        // it here compiled to 3 more instructions on this path (budget bench, 2026-11-22).
+        // Reference limited to ±ref_lim, NaN → 0 (`math::clamp_symmetric`, with the flag set
+        // in its out-of-range branch).
         let (r0, lim) = (x.reference, k.ref_lim);
-        let r = if r0 >= -lim {
-            if r0 <= lim {
-                r0
-            } else {
-                lim
-            }
-        } else if r0 < -lim {
-            -lim
+        let r = if crate::math::abs(r0) <= lim {
+            r0
         } else {
-            0.0
-        };
-        if r != r0 {
             fl |= flags::REFERENCE_LIMITED;
-        }
+            crate::math::limit_sign(r0, lim)
+        };
         let i_ref = match k.mode {
             LoopMode::Torque => {
-                let (model, ms) = (&self.est.model, &s.est.model);
-                let t_static = |bb: f32| static_output(model, ms, bb, i) * scale;
-                // Below the torque at B = 0 (from the slow pass) nothing can be reached:
-                // aim there.
-                let t0 = s.t_floor;
-                let r_eff = if t0 > r { t0 } else { r };
-                // One chord step per sample from the last solution (slope from the slow pass).
-                let b_star = chord_step(t_static, r_eff, s.b_star, s.ff_inv_slope, k.ff_hi, k.ff_step);
-                s.b_star = b_star;
-                let i_ff = b_star * k.amp_per_b;
-                let ff = clamp(i_ff + k.lead * (i_ff - s.i_ff), 0.0, k.i_max);
-                s.i_ff = i_ff;
-                step_limited(k.kp_t, k.ki_t_dt, &mut s.pi_t, r_eff - t_est, ff, 0.0, k.i_max)
+                // The torque loop runs at half the sample rate in two phases on alternate
+                // samples, the current loop below every sample: the feed-forward, then
+                // the PI on it and on this sample's estimate; its output is held between.
+                s.pi_phase = !s.pi_phase;
+                if s.pi_phase {
+                    let e = s.r_last - t_est;
+                    s.i_ref = step_limited(k.kp_t, k.ki_t_dt, &mut s.pi_t, e, s.ff_i, 0.0, k.i_max);
+                } else {
+                    // Below the torque at B = 0 (from the slow pass) nothing can be
+                    // reached: aim there.
+                    let t0 = s.t_floor;
+                    let r_eff = if t0 > r { t0 } else { r };
+                    // The lead acts on the reference, ahead of the feed-forward's affine
+                    // map (the same as on its current while the map holds).
+                    let r_lead = r_eff + k.lead * (r_eff - s.r_last);
+                    s.r_last = r_eff;
+                    s.ff_i = s.ff.current(r_lead);
+                }
+                s.i_ref
             }
             LoopMode::OpenLoopTorque => StaticMap { a: cfg.get().map }.current(r, k.i_max),
             LoopMode::Current => r,

@@ -197,21 +197,31 @@ pub struct Fast {
     pub model_bad: bool,
 }
 
-/// Whether any fast condition holds. Branch-free, NaN-proof (a NaN supply is outside
-/// the window); the current is finite by construction (counts × gain).
+/// Whether any fast condition holds. NaN-proof (a NaN supply is outside the window); the
+/// current is finite by construction (counts × gain).
 #[inline(always)]
 pub fn fast_any(k: &Coeffs, f: &Fast) -> bool {
-    fast_any_clamped(k, f, super::pi::clamp(f.supply_v, k.v_min, k.v_max))
+    fast_any_with(k, f, supply_window(k, f.supply_v).1)
 }
 
-/// [`fast_any`] with the supply already limited to its window (`supply_in`, NaN → `v_min`),
-/// as the step computes it anyway: out of the window iff it differs from the reading.
+/// [`fast_any`] with the supply test already made (`supply_bad` from [`supply_window`], as
+/// the step needs the limited supply anyway). Branch-free.
 #[inline(always)]
-pub fn fast_any_clamped(k: &Coeffs, f: &Fast, supply_in: f32) -> bool {
+pub fn fast_any_with(k: &Coeffs, f: &Fast, supply_bad: bool) -> bool {
     let rail = u32::from(f.hall).wrapping_sub(k.rail_base) >= k.rail_span;
     let over = crate::math::abs(f.i) > k.over_current;
-    let supply_bad = supply_in != f.supply_v;
     rail | over | supply_bad | f.overrun | f.model_bad
+}
+
+/// The supply `v` (V) limited to its window `[v_min, v_max]` (NaN → `v_min`), and whether
+/// it was outside (a fast condition). Inside the window (the usual case) two compares.
+#[inline(always)]
+pub fn supply_window(k: &Coeffs, v: f32) -> (f32, bool) {
+    if v >= k.v_min && v <= k.v_max {
+        (v, false)
+    } else {
+        (super::pi::clamp(v, k.v_min, k.v_max), true)
+    }
 }
 
 /// Count a fast condition; true when it has held `confirm` consecutive samples.
