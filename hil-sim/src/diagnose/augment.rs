@@ -144,14 +144,18 @@ struct AugSim<'p, 'a> {
     cache: std::sync::Mutex<Option<CachedPiece>>,
 }
 
-type CachedPiece = (u64, std::sync::Arc<(Vec<model_core::Kin>, Vec<Transform>, Vec<Term>)>);
+/// Kinematics, transforms and terms at one tuning value.
+type Piece = (Vec<model_core::Kin>, Vec<Transform>, Vec<Term>);
+type CachedPiece = (u64, std::sync::Arc<Piece>);
+/// Base output, β, prediction, its mean squared error, transforms and terms (`AugSim::full`).
+type Full = (Vec<f64>, Vec<f64>, Vec<f64>, f64, Vec<Transform>, Vec<Term>);
 
 impl AugSim<'_, '_> {
     fn n_base(&self) -> usize {
         self.prob.sim.n_params()
     }
     /// Kinematics, transforms and terms at `g`.
-    fn at(&self, g: f64) -> Option<std::sync::Arc<(Vec<model_core::Kin>, Vec<Transform>, Vec<Term>)>> {
+    fn at(&self, g: f64) -> Option<std::sync::Arc<Piece>> {
         if let Ok(c) = self.cache.lock() {
             if let Some((k, v)) = c.as_ref().filter(|(k, _)| *k == g.to_bits()) {
                 let _ = k;
@@ -173,7 +177,7 @@ impl AugSim<'_, '_> {
         Some(v)
     }
     /// The base output, β and the prediction over the whole recording for `p`.
-    fn full(&self, p: &[f64]) -> Option<(Vec<f64>, Vec<f64>, Vec<f64>, f64, Vec<Transform>, Vec<Term>)> {
+    fn full(&self, p: &[f64]) -> Option<Full> {
         let theta = p.get(..self.n_base())?;
         let g = p.get(self.n_base()).copied().unwrap_or(0.0);
         let piece = self.at(g)?;

@@ -67,7 +67,8 @@ pub fn windows(t: &[f64], e: &[f64], dt: f64, factor: f64, max: usize) -> Vec<(f
     sorted.sort_by(f64::total_cmp);
     let q = |f: f64| sorted.get(((sorted.len().max(1) - 1) as f64 * f) as usize).copied().unwrap_or(0.0);
     let (median, q90, peak) = (q(0.5), q(0.9), q(0.97));
-    if !(peak > 0.0) || peak < factor * median {
+    // Not positive, or NaN.
+    if peak.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) || peak < factor * median {
         return Vec::new();
     }
     let thr = q90.max(0.5 * peak);
@@ -108,7 +109,7 @@ fn quarters(name: &str, v: &[f64], e: &[f64], rows: &[usize]) -> Vec<Condition> 
     let edges = [f64::NEG_INFINITY, q(0.25), q(0.5), q(0.75), f64::INFINITY];
     let names = ["bottom quarter", "second quarter", "third quarter", "top quarter"];
     let total: f64 = rows.iter().map(|&i| e[i]).sum();
-    if !(total > 0.0) {
+    if total.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
         return Vec::new();
     }
     (0..4)
