@@ -42,6 +42,8 @@ use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
+use super::lm::PENALTY;
+
 /// Clamp of the normalised inputs (as the core's `U_LIM`).
 const U_LIM: f32 = 1.0e6;
 
@@ -264,9 +266,6 @@ impl Problem<'_> {
         th
     }
 }
-
-/// Residual of a rejected trial point (normalised units): large, so the solver backs off.
-const PENALTY: f64 = 1e3;
 
 impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
     type ResidualStorage = Owned<f64, Dyn>;
