@@ -19,7 +19,7 @@ use super::objective::Objective;
 const FD_STEP: f64 = 3e-4;
 /// Residual of an invalid trial point, in units of the output's spread: large enough that
 /// the solver rejects the step and shrinks its trust region.
-const PENALTY: f64 = 1e3;
+pub(super) const PENALTY: f64 = 1e3;
 
 /// What one local fit did.
 #[derive(Clone, Debug, PartialEq)]

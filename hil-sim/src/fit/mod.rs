@@ -18,6 +18,7 @@ pub mod global;
 pub mod linear;
 pub mod lm;
 pub mod narx;
+pub mod narx_net;
 pub mod nnls;
 pub mod objective;
 pub mod operator;
@@ -476,15 +477,10 @@ fn identify(
         Strategy::Network => {
             // Both networks are discrete-time (one step per sample): the step size only has
             // to be valid.
-            // Budgets that keep each network to a few seconds on the Dyke files: the NARX net
-            // has 79 free weights (one network run per weight per Jacobian), the small
-            // Hammerstein–Wiener one 32.
-            let lm_its = opts.lm_iterations.max(1);
-            let (iterations, window) = if id == "narx" {
-                (lm_its + 4, opts.swarm_window.min(6000))
-            } else {
-                (3 * lm_its, opts.swarm_window.min(6000))
-            };
+            // Budget that keeps the Hammerstein–Wiener fit (32 free weights, one network run
+            // per weight per Jacobian) to a few seconds on the Dyke files; NARX has its own
+            // ([`narx_net::Effort`]).
+            let (iterations, window) = (3 * opts.lm_iterations.max(1), opts.swarm_window.min(6000));
             let t = narx::train(id, kin, y, rows, 1e-3, sp.rate, iterations, window, opts.swarm.seed)
                 .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
             valid_or_err(id, sim, t.params, t.evaluations)

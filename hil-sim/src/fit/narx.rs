@@ -1,13 +1,13 @@
 //! Training of the data-driven models of seed 000 (NARX, eq. 18–19; Hammerstein–Wiener,
 //! eq. 15–17) on the host, in simulation mode: the network runs on its own past output,
-//! as on the board, and Levenberg–Marquardt ([`super::lm`], the `levenberg-marquardt`
-//! crate) minimises that simulation error through the f32 core.
+//! as on the board, and Levenberg–Marquardt (the `levenberg-marquardt` crate) minimises
+//! that simulation error.
 //!
 //! - NARX: the registered size ([`model_core::models::narx::Registered`], 8 sigmoid units,
-//!   86 values) is trained directly. Start: the linear part from a closed-form FIR fit
-//!   (no output feedback, so the start is stable), the hidden units small and random (fixed
-//!   seed).
-//! - Hammerstein–Wiener: a small network (3 + 3 sigmoid units, 32 values) is trained and
+//!   86 values) is trained directly by [`super::narx_net`] (exact Jacobian through the
+//!   recursion, a static start with and without a slow state in the output feedback,
+//!   selection on a validation block of the training part).
+//! - Hammerstein–Wiener (LM through the f32 core, [`super::lm`]): a small network (3 + 3 sigmoid units, 32 values) is trained and
 //!   written into the registered size with the remaining units at zero weight (they add
 //!   exactly nothing), so the fit costs seconds, not the minutes 95 free weights would.
 //!   Start: both static nets the identity plus small random units, the linear block a pure
@@ -38,7 +38,8 @@ pub struct Trained {
     /// Flat vector of the registered model.
     pub params: Vec<f64>,
     pub evaluations: usize,
-    /// Mean squared scaled residual on the (subsampled) training rows.
+    /// Mean squared scaled residual the choice was made on: the (subsampled) training rows
+    /// (Hammerstein–Wiener), the validation block of the training part (NARX).
     pub cost: f64,
 }
 
@@ -61,10 +62,11 @@ fn subsample(rows: &[usize]) -> Vec<usize> {
 }
 
 /// Train model `id` (`narx` or `hammerstein_wiener`) on `rows` of `kin` → `y`.
-/// `iterations`: Levenberg–Marquardt iterations (Jacobians) on the first `window` samples,
-/// then a few more on the first three windows (every Jacobian runs the network once per
-/// free weight over its stretch, so this bounds the cost on long recordings). `None` for another model or when no
-/// valid network was found.
+/// Hammerstein–Wiener: `iterations` Levenberg–Marquardt iterations (Jacobians) on the first
+/// `window` samples, then a few more on the first three windows (every Jacobian runs the
+/// network once per free weight over its stretch, so this bounds the cost on long
+/// recordings). NARX: the budget of [`super::narx_net::Effort::default`] (its Jacobian costs
+/// one pass, not one per weight). `None` for another model or when no valid network was found.
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     id: &str,
@@ -86,44 +88,7 @@ pub fn train(
     let mut rng = StdRng::seed_from_u64(seed);
     let sub = subsample(rows);
     let (spec, sim) = match id {
-        "narx" => {
-            use model_core::models::narx::Registered as Nx;
-            use model_core::Model;
-            let h = (Nx::N_PARAMS - 14) / 9;
-            // FIR start: ŷ(t) = Σ bₖ·û(t−k) + c, closed form on the training rows.
-            let un = |i: usize| (f64::from(kin.get(i).map_or(0.0, |k| k.x)) - xm) / xsd;
-            let fir_rows: Vec<usize> = rows.iter().copied().filter(|&i| i >= 5).collect();
-            let mut cols: Vec<Vec<f64>> =
-                (0..6).map(|lag| (0..kin.len()).map(|i| un(i.saturating_sub(lag))).collect()).collect();
-            cols.push(vec![1.0; kin.len()]);
-            let yn: Vec<f64> = y.iter().map(|v| (v - ym) / ysd).collect();
-            let (g, b) = super::nnls::normal_equations(&cols, &yn, &fir_rows);
-            let fir = super::nnls::solve(&g, &b, &[false; 7])?;
-            let mut p = vec![
-                fixed("u_mean", xm),
-                fixed("u_scale", xsd),
-                fixed("y_mean", ym),
-                fixed("y_scale", ysd),
-                ps("lin", -5.0, 5.0, 0.0),
-            ];
-            for k in 0..6 {
-                p.push(ps("lin", -20.0, 20.0, fir[k]));
-            }
-            for _ in 0..7 * h {
-                p.push(ps("hid_w", -10.0, 10.0, rng.random_range(-0.7..0.7)));
-            }
-            for _ in 0..h {
-                p.push(ps("hid_b", -10.0, 10.0, rng.random_range(-1.0..1.0)));
-            }
-            for _ in 0..h {
-                p.push(ps("out_a", -10.0, 10.0, rng.random_range(-0.1..0.1)));
-            }
-            p.push(ps("offset", -10.0, 10.0, fir[6]));
-            let margin = 0.25 * (yhi - ylo).max(1e-9);
-            p.push(fixed("y_min", ylo - margin));
-            p.push(fixed("y_max", yhi + margin));
-            (p, simulator_of::<Nx>(dt))
-        }
+        "narx" => return train_narx(kin, y, rows, dt, (xm, xsd), (ym, ysd), (ylo, yhi), seed),
         "hammerstein_wiener" => {
             let (nh, nw) = HW_TRAINED;
             // Output net's line: y ≈ w_lin·x + w_d.
@@ -232,4 +197,45 @@ fn registered_nw() -> usize {
         .get(7)
         .and_then(|n| n.split_once('[').and_then(|(_, r)| r.trim_end_matches(']').parse().ok()))
         .unwrap_or(0)
+}
+
+/// NARX at the registered size, trained by [`super::narx_net`]; the output clamp is the
+/// training range widened by a quarter of its span on each side.
+#[allow(clippy::too_many_arguments)]
+fn train_narx(
+    kin: &[Kin],
+    y: &[f64],
+    rows: &[usize],
+    dt: f32,
+    (xm, xsd): (f64, f64),
+    (ym, ysd): (f64, f64),
+    (ylo, yhi): (f64, f64),
+    seed: u64,
+) -> Option<Trained> {
+    use super::narx_net::{Effort, Shape, Twin};
+    use model_core::models::narx::Registered as Nx;
+    use model_core::Model;
+    let h = (Nx::N_PARAMS - 14) / 9;
+    let margin = 0.25 * (yhi - ylo).max(1e-9);
+    let clamp = (ylo - margin, yhi + margin);
+    let twin = Twin::new(Shape { h }, kin, y, (xm, xsd), (ym, ysd), clamp);
+    // The free block is the core's flat vector between the normalisation and the clamp.
+    let flat = |th: &[f64]| -> Vec<f64> {
+        let mut p = vec![xm, xsd, ym, ysd];
+        p.extend_from_slice(th);
+        p.extend([clamp.0, clamp.1]);
+        p
+    };
+    let sim = simulator_of::<Nx>(dt);
+    let score = |th: &[f64], at: &[usize]| -> f64 {
+        let end = at.last().map_or(0, |r| r + 1).min(kin.len());
+        let mut out = vec![0.0; end];
+        if at.is_empty() || !sim.run(&flat(th), &kin[..end], &mut out) {
+            return f64::INFINITY;
+        }
+        at.iter().map(|&i| ((out[i] - y.get(i).copied().unwrap_or(0.0)) / ysd).powi(2)).sum::<f64>() / at.len() as f64
+    };
+    let net = super::narx_net::train(&twin, rows, &Effort::default(), seed, &score)?;
+    let params = flat(&net.theta);
+    (params.len() == Nx::N_PARAMS).then_some(Trained { params, evaluations: net.runs, cost: net.validation })
 }

@@ -28,9 +28,11 @@
 //! scales in `[1e−12, 1e12]`, `y_min < y_max`.
 //!
 //! State: the five past inputs (raw) and the last output. It starts at the first sample
-//! repeated and at the fixed point of the recursion for that constant input (32
-//! iterations of the clamped map from `y_mean`), so a constant input starts in steady state
-//! when the recursion converges.
+//! repeated and at a fixed point `y = f(y)` of the clamped map for that constant input
+//! (32 bisection steps on `f(y) − y` over `[y_min, y_max]`, which always bracket one), so a
+//! constant input starts in steady state even when the output feedback carries a slow
+//! state (W₁ close to 1, see `hil-sim`'s training), which plain iteration of the map would
+//! take thousands of steps to settle.
 
 use crate::error::{check, count, time_step};
 use crate::math::clamp;
@@ -220,11 +222,18 @@ impl<const H: usize> Model for Narx<H> {
     fn initial_state(&self, first: &Kin) -> State {
         let u0 = if first.x.is_finite() { first.x } else { self.u_mean };
         let past = [u0; 5];
-        let mut y = clamp(self.y_mean, self.y_min, self.y_max);
+        // Bisection on eval(y) − y over [y_min, y_max]: eval maps into that range, so
+        // eval(y_min) ≥ y_min and eval(y_max) ≤ y_max bracket a fixed point (module doc).
+        let (mut lo, mut hi) = (self.y_min, self.y_max);
         for _ in 0..32 {
-            y = self.eval(y, u0, &past);
+            let mid = 0.5 * (lo + hi);
+            if self.eval(mid, u0, &past) > mid {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
         }
-        State { u: past, y }
+        State { u: past, y: self.eval(0.5 * (lo + hi), u0, &past) }
     }
 
     #[inline]
@@ -335,6 +344,32 @@ mod tests {
         for _ in 0..5 {
             let y = m.step(&mut s, &Kin::new(0.7, 0.0, 0.0, 0.0));
             assert!((y - y0).abs() < 1e-4 * (1.0 + y0.abs()), "{y} vs {y0}");
+        }
+    }
+
+    #[test]
+    fn steady_start_with_a_slow_feedback() {
+        // W₁ = 0.9995: iterating the map 32 times would leave the start far from steady.
+        let m = small();
+        let m = Narx::<2>::new(
+            (m.u_mean, m.u_scale, m.y_mean, m.y_scale),
+            [0.9995, 0.3, -0.2, 0.1, 0.05, -0.05, 0.02],
+            m.hid_w,
+            m.hid_b,
+            m.out_a,
+            0.01,
+            (-1.0e5, 1.0e5),
+            1e-3,
+        )
+        .unwrap();
+        let k = Kin::new(0.7, 0.0, 0.0, 0.0);
+        let mut s = m.initial_state(&k);
+        let y0 = s.y;
+        // An interior fixed point, far from y_mean.
+        assert!(y0.abs() > 100.0 && y0.abs() < 0.5e5, "{y0}");
+        for _ in 0..200 {
+            let y = m.step(&mut s, &k);
+            assert!((y - y0).abs() < 1e-3 * (1.0 + y0.abs()), "{y} vs {y0}");
         }
     }
 
