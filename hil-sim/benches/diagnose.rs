@@ -19,8 +19,7 @@ fn bench(c: &mut Criterion) {
     let ch = Channels::default();
     let data = Dataset::new(&rec, &ch, 0.7, None).expect("dataset");
     assert_eq!(data.len(), 60_000);
-    let aux: Vec<(String, Vec<f64>)> =
-        rec.auxiliary(&ch).into_iter().filter_map(|n| Some((n.to_owned(), rec.channel(n).ok()?.to_vec()))).collect();
+    let aux = rec.auxiliary_channels(&ch);
     let mut group = c.benchmark_group("diagnose");
     group.sample_size(10);
     for (name, model) in [("bouc_wen_30s_2khz", Some("bouc_wen")), ("auto_30s_2khz", None)] {

@@ -156,6 +156,16 @@ impl Recording {
             .collect()
     }
 
+    /// The auxiliary channels (as [`Recording::auxiliary`]) with their values.
+    pub fn auxiliary_channels(&self, ch: &Channels) -> Vec<(String, Vec<f64>)> {
+        let names = self.auxiliary(ch);
+        self.columns
+            .iter()
+            .filter(|c| names.contains(&c.name.as_str()))
+            .map(|c| (c.name.clone(), c.values.clone()))
+            .collect()
+    }
+
     /// Read a CSV recording.
     pub fn read_csv(path: &Path) -> Result<Self, RecordingError> {
         let bytes = std::fs::read(path).map_err(|source| RecordingError::Io { path: path.to_path_buf(), source })?;

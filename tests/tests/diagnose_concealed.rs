@@ -65,8 +65,7 @@ fn run(effect: &str, base: &str, excitation: &str, seed: u64) -> Outcome {
     // standstill) are left out of the fit and the scores.
     let excluded = hil_sim::quality::check(&rec, &ch).expect("quality check").excluded();
     let data = Dataset::new(&rec, &ch, 0.7, Some(excluded)).expect("dataset");
-    let aux: Vec<(String, Vec<f64>)> =
-        rec.auxiliary(&ch).into_iter().map(|n| (n.to_owned(), rec.channel(n).unwrap().to_vec())).collect();
+    let aux = rec.auxiliary_channels(&ch);
     let opts = DiagnoseOptions { model: Some(base.into()), ..DiagnoseOptions::default() };
     let d = diagnose(&data, aux, None, ("b", "torque"), &opts, &indicatif::ProgressBar::hidden())
         .unwrap_or_else(|e| panic!("{effect}/{base}/{excitation}: {e}"));

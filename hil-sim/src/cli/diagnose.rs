@@ -54,11 +54,7 @@ pub fn run_diagnosis(a: &DiagnoseArgs) -> anyhow::Result<(Diagnosis, Dataset)> {
     }
     let excluded = (!a.ch.keep_flagged).then(|| q.excluded());
     let data = Dataset::new(&rec, &ch, 1.0 - a.heldout, excluded).with_context(|| format!("{}", path.display()))?;
-    let aux: Vec<(String, Vec<f64>)> = rec
-        .auxiliary(&ch)
-        .into_iter()
-        .filter_map(|n| rec.channel(n).ok().map(|v| (n.to_owned(), v.to_vec())))
-        .collect();
+    let aux = rec.auxiliary_channels(&ch);
     let opts = DiagnoseOptions {
         model: (a.model != "auto").then(|| a.model.clone()),
         heldout: a.heldout,
