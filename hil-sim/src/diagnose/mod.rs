@@ -492,15 +492,21 @@ fn refit_candidate(
                 let tune = Tune { build: &build, start: g, lo, hi, log: lo > 0.0 };
                 prob.refit(&current.transforms, &current.terms, Some(&tune), theta, iterations)
             } else {
-                let (t, extra) = build(g);
-                let mut transforms = current.transforms.clone();
-                transforms.extend(t);
-                let mut terms = current.terms.clone();
-                terms.extend(extra);
+                let (transforms, terms) = with_candidate(current, c, g);
                 prob.refit(&transforms, &terms, None, theta, iterations).map(|r| (r.0, g))
             }
         })
         .min_by(|a, b| a.0.train_mse.total_cmp(&b.0.train_mse))
+}
+
+/// The transforms and terms of `current` with candidate `c`'s piece at value `g` added.
+fn with_candidate(current: &Fitted, c: &Candidate, g: f64) -> (Vec<Transform>, Vec<Term>) {
+    let piece = (c.build)(g);
+    let mut transforms = current.transforms.clone();
+    transforms.extend(piece.transform);
+    let mut terms = current.terms.clone();
+    terms.extend(piece.terms);
+    (transforms, terms)
 }
 
 /// A starting value of a candidate's refit, with the base parameters θ to start from
@@ -528,11 +534,7 @@ fn mask(e: &mut [f64], rows: &[usize]) {
 /// part of an effect, which shifts the linearised minimum; the refit decides).
 fn starts_on_grid(prob: &Problem<'_>, c: &Candidate, current: &Fitted, jac: &[Vec<f64>]) -> Vec<Start> {
     let cost_at = |g: f64| -> Option<f64> {
-        let piece = (c.build)(g);
-        let mut transforms = current.transforms.clone();
-        transforms.extend(piece.transform.clone());
-        let mut terms: Vec<Term> = current.terms.clone();
-        terms.extend(piece.terms);
+        let (transforms, terms) = with_candidate(current, c, g);
         prob.scan_cost(&transforms, &terms, &current.theta, jac)
     };
     if c.grid.len() < 2 {
@@ -560,11 +562,7 @@ fn starts_on_grid(prob: &Problem<'_>, c: &Candidate, current: &Fitted, jac: &[Ve
                 let mut theta = current.theta.clone();
                 let mut out = Vec::with_capacity(chain.len());
                 for &g in chain {
-                    let piece = (c.build)(g);
-                    let mut transforms = current.transforms.clone();
-                    transforms.extend(piece.transform);
-                    let mut terms = current.terms.clone();
-                    terms.extend(piece.terms);
+                    let (transforms, terms) = with_candidate(current, c, g);
                     match prob.refit(&transforms, &terms, None, &theta, PROFILE_ITERATIONS) {
                         Some((f, _)) => {
                             out.push((g, f.train_mse, Some(f.theta.clone())));
