@@ -6,11 +6,11 @@
 //! models fitted first), as the CLI runs it (both cores).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use hil_sim::concealed::{generate, ConcealedSpec};
-use hil_sim::diagnose::{diagnose, DiagnoseOptions};
-use hil_sim::fit::Dataset;
-use hil_sim::recording::Recording;
-use hil_sim::replay::Channels;
+use hil_sim::ident::diagnose::{diagnose, DiagnoseOptions};
+use hil_sim::ident::fit::Dataset;
+use hil_sim::io::recording::Recording;
+use hil_sim::models::replay::Channels;
+use hil_sim::sim::concealed::{generate, ConcealedSpec};
 
 fn bench(c: &mut Criterion) {
     let spec = ConcealedSpec { effect: "field_lag".into(), base: "bouc_wen".into(), ..ConcealedSpec::default() };

@@ -4,14 +4,14 @@
 //! `scripts/scipy-baseline/` (same model, data and split).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use hil_sim::dispatch::{replay, RateChoice};
-use hil_sim::fit::{fit, Dataset, DelayChoice, FitOptions};
-use hil_sim::recording::Recording;
-use hil_sim::replay::Channels;
+use hil_sim::ident::fit::{fit, Dataset, DelayChoice, FitOptions};
+use hil_sim::io::recording::Recording;
+use hil_sim::models::replay::Channels;
+use hil_sim::models::{replay, RateChoice};
 use model_core::Sample;
 
 fn dyke(train: f64, take: Option<usize>) -> Dataset {
-    let path = hil_sim::data::data_file("dyke/ranran_50.csv").expect("bundled data");
+    let path = hil_sim::io::bundled::data_file("dyke/ranran_50.csv").expect("bundled data");
     let mut rec = Recording::read(&path).expect("readable");
     if let Some(n) = take {
         for c in &mut rec.columns {

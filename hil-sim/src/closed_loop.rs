@@ -4,7 +4,7 @@
 //! counts, supply voltage, temperature), the control step computes the new duty (PWM
 //! quantised to the timer's compare counts), and that duty is applied from the **next**
 //! sample on (one-sample computation delay); between samples the plant integrates every
-//! PWM edge ([`crate::plant`]). The true torque is the plant's.
+//! PWM edge ([`crate::sim::plant`]). The true torque is the plant's.
 //! The slow supervisor pass (`ControlStep::slow`) runs every millisecond, as in the firmware.
 //!
 //! [`identify`] plays the lab: on the simulated clutch, with the same step in current
@@ -21,10 +21,10 @@ use model_core::{Finite, Kin, Model, ParamError};
 use serde::Serialize;
 use thiserror::Error;
 
-use crate::metrics::{metrics, Metrics};
-use crate::plant::coil::CoilFault;
-use crate::plant::sensors::HallFault;
-use crate::plant::{ClutchParams, Plant};
+use crate::numerics::metrics::{metrics, Metrics};
+use crate::sim::plant::coil::CoilFault;
+use crate::sim::plant::sensors::HallFault;
+use crate::sim::plant::{ClutchParams, Plant};
 
 /// Why a loop run could not be set up.
 #[derive(Debug, Error)]
@@ -371,7 +371,7 @@ pub fn identify(clutch: &ClutchParams, control_hz: f64, seed: u64) -> Result<Ide
     let dt = cfg.get().dt;
     let err = |m: &str| LoopError::Identify(m.to_owned());
     // Static map: slow triangle 0–3 A, both branches.
-    let tri = |t: f64| 1.5 + 1.5 * crate::excitation::Excitation::Triangle { f: 0.25 }.at(t - 1.0).x;
+    let tri = |t: f64| 1.5 + 1.5 * crate::sim::excitation::Excitation::Triangle { f: 0.25 }.at(t - 1.0).x;
     let r = run(clutch, &drv, cfg, &tri, 9.0, seed, None);
     let k0 = r.after(T_START + 1.0);
     let rows: Vec<[f64; 4]> = r.current[k0..].iter().map(|i| [1.0, i.abs(), i * i, i.abs().powi(3)]).collect();
@@ -471,7 +471,7 @@ pub fn fault_run(
     let k_at = (0u32..).find(|&k| f64::from(k) * dt >= at).unwrap_or(0);
     let nan_after = if inj == Injection::ModelNan { k_at.saturating_sub(first_model_sample) } else { u32::MAX };
     let step = id.loop_step(nan_after)?;
-    let ms = crate::excitation::Excitation::seed000_multisine();
+    let ms = crate::sim::excitation::Excitation::seed000_multisine();
     let reference = move |t: f64| 6.0 + 4.0 * ms.at(t).x;
     let r = run(clutch, &step, cfg, &reference, at + 0.1, seed, Some(Schedule { injection: inj, at }));
     let k_inj = r.after(at);
@@ -500,7 +500,7 @@ pub fn fault_run(
 /// The multisine torque reference of the `multisine` scenario: seed 000 eq. 21 mapped to
 /// 6 ± 4 N·m (2–10 N·m).
 pub fn multisine_reference() -> impl Fn(f64) -> f64 {
-    let ms = crate::excitation::Excitation::seed000_multisine();
+    let ms = crate::sim::excitation::Excitation::seed000_multisine();
     move |t: f64| 6.0 + 4.0 * ms.at(t).x
 }
 

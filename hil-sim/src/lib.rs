@@ -1,27 +1,21 @@
-//! Host side of the MR clutch controller: recordings, replay through model-core,
-//! accuracy checks of the fixed-step core.
+//! Host side of the MR clutch controller: read recordings, replay them through model-core,
+//! identify and diagnose models, simulate the clutch, run the firmware's control step in
+//! closed loop, and measure the firmware's budgets.
+//!
+//! One room per responsibility: [`io`] (files in and out), [`quality`] (data-quality
+//! checks), [`models`] (what each model needs on the host, one file per model), [`ident`]
+//! (fit, compare, diagnose), [`sim`] (the clutch simulator, scenarios, excitations,
+//! concealed-effect recordings), [`closed_loop`], [`budget`], [`report`] (plots and the
+//! HTML report), [`numerics`] (least squares, statistics, derivatives, metrics). The CLI
+//! (`src/cli/`, binary only) parses flags, calls one function here and prints.
 
-pub mod accuracy;
-pub mod alignment;
 pub mod budget;
 pub mod closed_loop;
-pub mod compare;
-pub mod concealed;
-pub mod data;
-pub mod diagnose;
-pub mod dispatch;
-pub mod excitation;
-pub mod export;
-pub mod fit;
-pub mod fit_report;
-pub mod metrics;
-pub mod params_file;
-pub mod plant;
-pub mod plot;
+pub mod ident;
+pub mod io;
+pub mod models;
+pub mod numerics;
+pub mod progress;
 pub mod quality;
-pub mod rate_offline;
-pub mod recording;
-pub mod reference;
-pub mod replay;
 pub mod report;
-pub mod scenario;
+pub mod sim;

@@ -17,8 +17,8 @@
 
 use serde::Serialize;
 
-use crate::recording::{Recording, RecordingError};
-use crate::replay::Channels;
+use crate::io::recording::{Recording, RecordingError};
+use crate::models::replay::Channels;
 
 /// What a warning is about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -569,7 +569,7 @@ mod tests {
     use std::path::Path;
 
     use super::*;
-    use crate::recording::Column;
+    use crate::io::recording::Column;
 
     const FS: f64 = 1000.0;
 

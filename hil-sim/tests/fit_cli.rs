@@ -12,7 +12,7 @@ fn hil_sim(args: &[&str]) -> (i32, String, String) {
 }
 
 fn dyke(name: &str) -> String {
-    hil_sim::data::data_file(&format!("dyke/{name}")).unwrap().display().to_string()
+    hil_sim::io::bundled::data_file(&format!("dyke/{name}")).unwrap().display().to_string()
 }
 
 /// The acceptance command, on three models: contract fields, the quality warning,

@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use hil_sim::recording::{Recording, RecordingError};
+use hil_sim::io::recording::{Recording, RecordingError};
 use proptest::prelude::*;
 
 const GOOD_CSV: &[u8] =
@@ -30,7 +30,7 @@ fn consistent(r: &Result<Recording, RecordingError>, name: &str) -> Result<(), T
             }
             prop_assert!(rec.constants.iter().all(|c| c.1.is_finite()));
             // Whatever parses also goes through the quality check without panicking.
-            let _ = hil_sim::quality::check(rec, &hil_sim::replay::Channels::default());
+            let _ = hil_sim::quality::check(rec, &hil_sim::models::replay::Channels::default());
         }
         Err(e) => {
             let m = e.to_string();

@@ -3,9 +3,9 @@
 
 use std::path::{Path, PathBuf};
 
+use hil_sim::io::recording::Recording;
+use hil_sim::models::replay::Channels;
 use hil_sim::quality::{check, WarningKind};
-use hil_sim::recording::Recording;
-use hil_sim::replay::Channels;
 
 fn dyke(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/dyke").join(name)

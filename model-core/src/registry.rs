@@ -5,7 +5,6 @@
 //! list (this table, [`visit`], the host's per-model registry in `hil-sim`) is built from
 //! it, so an 18th model is one line here plus its module.
 
-use crate::models;
 use crate::Model;
 
 /// Static description of one model.

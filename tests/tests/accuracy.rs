@@ -2,11 +2,11 @@
 //! f64 adaptive-step reference for every ODE model and published parameter set, on the
 //! papers' excitations at 500 Hz and 3 kHz and on the real Dyke displacement.
 
-use hil_sim::accuracy::{self, MAX_R_RMSE};
+use hil_sim::models::accuracy::{self, MAX_R_RMSE};
 
 #[test]
 fn every_ode_model_meets_the_bound() {
-    let path = hil_sim::data::data_file("dyke/ranran_50.csv").expect("bundled Dyke recording");
+    let path = hil_sim::io::bundled::data_file("dyke/ranran_50.csv").expect("bundled Dyke recording");
     let rec = accuracy::load_dyke(&path).unwrap();
     let rows = accuracy::run_all(None, false, Some(&rec), &|| {}).unwrap();
     for id in ["bouc_wen", "lugre", "spencer", "dahl", "bouc_wen_asym"] {

@@ -2,8 +2,8 @@
 //! `model_core::control::page`, and what export writes is what the firmware's decoder
 //! reads back, model parameters included.
 
-use hil_sim::export;
-use hil_sim::params_file::ParamsFile;
+use hil_sim::io::config_page;
+use hil_sim::io::params_file::ParamsFile;
 use model_core::control::config::WORDS;
 use model_core::control::{ConfigImage, PageError, RateSpec};
 use model_core::models::spencer::Spencer;
@@ -14,8 +14,8 @@ use std::path::Path;
 fn export_round_trips_through_the_firmware_decoder() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../hil-sim/params/spencer_dyke_1997.json");
     let file = ParamsFile::read(&path).unwrap();
-    let control = export::default_control(20_000.0).unwrap();
-    let img = export::image(&file, &path, control).unwrap();
+    let control = config_page::default_control(20_000.0).unwrap();
+    let img = config_page::image(&file, &path, control).unwrap();
     let bytes = img.encode();
     let back = ConfigImage::decode(&bytes).unwrap();
     assert_eq!(back, img);
@@ -43,11 +43,11 @@ fn export_uses_the_files_rate_and_rejects_bad_sets() {
         r#"{"model":"lugre","rate":"kalman:1e6:1e-6","params":{"alpha":4.312,"beta":5.771,"epsilon":0.003,"c":-0.151,"k":4.297,"t0":5.225}}"#,
     )
     .unwrap();
-    let control = export::default_control(20_000.0).unwrap();
-    let img = export::image(&ParamsFile::read(&p).unwrap(), &p, control).unwrap();
+    let control = config_page::default_control(20_000.0).unwrap();
+    let img = config_page::image(&ParamsFile::read(&p).unwrap(), &p, control).unwrap();
     assert_eq!(img.rate, RateSpec::Kalman { q: 1e6, r: 1e-6 });
     std::fs::write(&p, r#"{"model":"lugre","params":[-1,0,0,0,0,0]}"#).unwrap();
-    let e = export::image(&ParamsFile::read(&p).unwrap(), &p, control).unwrap_err();
+    let e = config_page::image(&ParamsFile::read(&p).unwrap(), &p, control).unwrap_err();
     assert!(format!("{e:#}").contains("alpha"), "{e:#}");
     std::fs::remove_dir_all(&dir).ok();
 }

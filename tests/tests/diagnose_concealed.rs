@@ -20,11 +20,11 @@
 
 use std::path::Path;
 
-use hil_sim::concealed::{generate, ConcealedSpec};
-use hil_sim::diagnose::{diagnose, DiagnoseOptions};
-use hil_sim::fit::Dataset;
-use hil_sim::recording::Recording;
-use hil_sim::replay::Channels;
+use hil_sim::ident::diagnose::{diagnose, DiagnoseOptions};
+use hil_sim::ident::fit::Dataset;
+use hil_sim::io::recording::Recording;
+use hil_sim::models::replay::Channels;
+use hil_sim::sim::concealed::{generate, ConcealedSpec};
 
 const EFFECTS: [&str; 9] = [
     "field_lag",

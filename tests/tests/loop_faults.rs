@@ -7,7 +7,7 @@
 //! Heavy simulations: run with `cargo test --release -p integration-tests --test loop_faults`.
 
 use hil_sim::closed_loop::{compare, fault_run, identify, multisine_reference, Identified, Injection, T_START};
-use hil_sim::plant::ClutchParams;
+use hil_sim::sim::plant::ClutchParams;
 use std::sync::OnceLock;
 
 fn identified() -> &'static (ClutchParams, Identified) {

@@ -10,11 +10,11 @@
 use std::path::Path;
 use std::sync::OnceLock;
 
-use hil_sim::fit::{fit, Dataset, FitOptions, FitResult};
+use hil_sim::ident::fit::{fit, Dataset, FitOptions, FitResult};
+use hil_sim::io::recording::Recording;
+use hil_sim::models::replay::Channels;
 use hil_sim::quality;
-use hil_sim::recording::Recording;
-use hil_sim::replay::Channels;
-use hil_sim::scenario::Scenario;
+use hil_sim::sim::scenario::Scenario;
 use model_core::models::prandtl_ishlinskii::PrandtlIshlinskii;
 use model_core::{Kin, Model};
 

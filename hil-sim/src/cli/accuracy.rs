@@ -1,5 +1,5 @@
 use clap::Args;
-use hil_sim::accuracy::{self, Row, MAX_R_RMSE};
+use hil_sim::models::accuracy::{self, Row, MAX_R_RMSE};
 use serde_json::json;
 
 #[derive(Args, Debug)]
@@ -22,7 +22,7 @@ pub fn rows(a: &AccuracyArgs) -> anyhow::Result<Vec<Row>> {
     let rec = if a.no_recording {
         None
     } else {
-        let path = hil_sim::data::data_file("dyke/ranran_50.csv").map_err(anyhow::Error::msg)?;
+        let path = hil_sim::io::bundled::data_file("dyke/ranran_50.csv").map_err(anyhow::Error::msg)?;
         Some(accuracy::load_dyke(&path).map_err(anyhow::Error::msg)?)
     };
     if let Some(m) = &a.model {

@@ -2,10 +2,10 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context};
 use clap::Args;
-use hil_sim::compare::{compare, Named};
-use hil_sim::fit::{Dataset, FitOptions};
+use hil_sim::ident::compare::{compare, Named};
+use hil_sim::ident::fit::{Dataset, FitOptions};
+use hil_sim::io::recording::Recording;
 use hil_sim::quality;
-use hil_sim::recording::Recording;
 use serde_json::json;
 
 use super::ChannelArgs;

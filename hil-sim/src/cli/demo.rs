@@ -3,16 +3,16 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::Args;
 use hil_sim::closed_loop::{compare as loop_compare, identify, multisine_reference, Run, T_START};
-use hil_sim::dispatch::RateChoice;
-use hil_sim::fit::{Dataset, FitOptions, FitResult};
-use hil_sim::fit_report::{error_bars, fit_plots, results_table, Labels};
-use hil_sim::params_file::ParamsFile;
-use hil_sim::plant::ClutchParams;
-use hil_sim::plot::{self, Series, Style};
+use hil_sim::ident::fit::{Dataset, FitOptions, FitResult};
+use hil_sim::io::params_file::ParamsFile;
+use hil_sim::io::recording::Recording;
+use hil_sim::models::replay::{replay_recording, Channels};
+use hil_sim::models::RateChoice;
 use hil_sim::quality;
-use hil_sim::recording::Recording;
-use hil_sim::replay::{replay_recording, Channels};
+use hil_sim::report::fit::{error_bars, fit_plots, results_table, Labels};
+use hil_sim::report::plot::{self, Series, Style};
 use hil_sim::report::Report;
+use hil_sim::sim::plant::ClutchParams;
 use serde_json::json;
 
 #[derive(Args, Debug)]
@@ -42,7 +42,7 @@ fn dyke_channels() -> Channels {
 }
 
 fn fit_dyke(file: &'static str) -> anyhow::Result<DykeFit> {
-    let path = hil_sim::data::data_file(file).map_err(anyhow::Error::msg)?;
+    let path = hil_sim::io::bundled::data_file(file).map_err(anyhow::Error::msg)?;
     let rec = Recording::read(&path)?;
     let ch = dyke_channels();
     let q = quality::check(&rec, &ch)?;
@@ -177,7 +177,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     // 4. A diagnosis: the damper file through a model that ignores the command voltage.
     eprintln!("diagnosing ranran_50.csv from bouc_wen without the command channel");
     let diag_args = super::diagnose::DiagnoseArgs {
-        rec: hil_sim::data::data_file("dyke/ranran_50.csv").map_err(anyhow::Error::msg)?,
+        rec: hil_sim::io::bundled::data_file("dyke/ranran_50.csv").map_err(anyhow::Error::msg)?,
         model: "bouc_wen".into(),
         heldout: 0.3,
         ch: super::ChannelArgs {
@@ -199,7 +199,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         "The classical Bouc–Wen model has no command input, so it cannot know that the damper's force follows the \
          command voltage Y. `diagnose` is given D and F only; Y and A are auxiliary channels it may use.",
     );
-    hil_sim::diagnose::report::section(&mut rep, &a.out, "diagnose_ranran50", &diag, ("D", "F"))?;
+    hil_sim::ident::diagnose::report::section(&mut rep, &a.out, "diagnose_ranran50", &diag, ("D", "F"))?;
     text += &format!("\ndiagnosis of ranran_50.csv from bouc_wen (no --command):\n{}", super::diagnose::text(&diag));
 
     // 5. The fixed-step core against f64 references (short runs).

@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use hil_sim::export;
-use hil_sim::params_file::ParamsFile;
+use hil_sim::io::config_page;
+use hil_sim::io::params_file::ParamsFile;
 use serde_json::json;
 
 #[derive(Args, Debug)]
@@ -16,7 +16,7 @@ pub struct ExportArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// Control-step rate of the firmware, Hz (the model's time step is its inverse).
-    #[arg(long, default_value_t = export::CONTROL_HZ)]
+    #[arg(long, default_value_t = config_page::CONTROL_HZ)]
     pub control_hz: f32,
     #[arg(long)]
     pub json: bool,
@@ -36,8 +36,8 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
             );
         }
     }
-    let control = export::default_control(a.control_hz)?;
-    let img = export::image(&file, &path, control)?;
+    let control = config_page::default_control(a.control_hz)?;
+    let img = config_page::image(&file, &path, control)?;
     let bytes = img.encode();
     std::fs::write(&a.out, bytes).with_context(|| format!("writing {}", a.out.display()))?;
     let len = u16::from_le_bytes([bytes[6], bytes[7]]);

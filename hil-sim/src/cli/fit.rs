@@ -3,11 +3,11 @@ use std::time::Instant;
 
 use anyhow::{bail, Context};
 use clap::Args;
-use hil_sim::fit::spec::FITTABLE;
-use hil_sim::fit::{fit, Dataset, DelayChoice, FitOptions, FitResult};
-use hil_sim::params_file::ParamsFile;
+use hil_sim::ident::fit::spec::FITTABLE;
+use hil_sim::ident::fit::{fit, Dataset, DelayChoice, FitOptions, FitResult};
+use hil_sim::io::params_file::ParamsFile;
+use hil_sim::io::recording::Recording;
 use hil_sim::quality;
-use hil_sim::recording::Recording;
 use serde_json::json;
 
 use super::ChannelArgs;
@@ -220,7 +220,7 @@ pub fn write_report(
     input: &str,
     output: &str,
 ) -> anyhow::Result<PathBuf> {
-    use hil_sim::fit_report::{error_bars, fit_plots, loop_plots, results_table, Labels};
+    use hil_sim::report::fit::{error_bars, fit_plots, loop_plots, results_table, Labels};
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut rep = hil_sim::report::Report::new(title);
     rep.paragraph(&format!(

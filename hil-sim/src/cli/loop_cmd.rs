@@ -5,9 +5,9 @@ use clap::{Args, ValueEnum};
 use hil_sim::closed_loop::{
     bandwidth, compare, fault_run, frequency_response, identify, multisine_reference, Injection, Run, T_START,
 };
-use hil_sim::metrics::metrics;
-use hil_sim::plant::ClutchParams;
-use hil_sim::scenario::Scenario;
+use hil_sim::numerics::metrics::metrics;
+use hil_sim::sim::plant::ClutchParams;
+use hil_sim::sim::scenario::Scenario;
 use serde_json::{json, Value};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]

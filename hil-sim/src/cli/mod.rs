@@ -17,8 +17,8 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use clap::{Args, Parser, Subcommand};
-use hil_sim::dispatch::RateChoice;
-use hil_sim::replay::Channels;
+use hil_sim::models::replay::Channels;
+use hil_sim::models::RateChoice;
 
 #[derive(Parser, Debug)]
 #[command(name = "hil-sim", version, about = "Host tooling for the MR clutch torque controller")]

@@ -2,10 +2,10 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use hil_sim::params_file::ParamsFile;
+use hil_sim::io::params_file::ParamsFile;
+use hil_sim::io::recording::Recording;
+use hil_sim::models::replay::replay_recording;
 use hil_sim::quality;
-use hil_sim::recording::Recording;
-use hil_sim::replay::replay_recording;
 use serde_json::json;
 
 use super::ChannelArgs;
@@ -31,7 +31,7 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
     let rate = match (a.ch.rate()?, pf.rate.as_deref()) {
         (Some(r), _) => r,
         (None, Some(r)) => super::parse_rate(r).with_context(|| format!("{}: `rate`", a.params.display()))?,
-        (None, None) => hil_sim::dispatch::RateChoice::Backward,
+        (None, None) => hil_sim::models::RateChoice::Backward,
     };
     let flat = pf.flat(&a.params)?;
     let rec = Recording::read(&super::file_arg(&a.rec)?)?;
@@ -79,7 +79,7 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
 }
 
 /// `t,measured,model,residual` with a header row.
-fn write_trace(path: &std::path::Path, r: &hil_sim::replay::ReplayReport) -> anyhow::Result<()> {
+fn write_trace(path: &std::path::Path, r: &hil_sim::models::replay::ReplayReport) -> anyhow::Result<()> {
     let mut w = csv::Writer::from_path(path)?;
     w.write_record(["t", "measured", "model", "residual"])?;
     for ((t, y), m) in r.time.iter().zip(&r.measured).zip(&r.model_output) {

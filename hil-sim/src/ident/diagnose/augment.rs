@@ -1,0 +1,420 @@
+//! The model a diagnosis refits: the base model (parameters θ) fed a transformed input,
+//! plus terms linear in their coefficients β,
+//!
+//! ```text
+//! ŷ(t) = m_θ(T(x))(t) + Σ_k β_k · φ_k(t),      φ_k = v_k  or  φ_k = m_θ · v_k
+//! ```
+//!
+//! `T` chains the input transforms the catalog names (delay, first-order lag, saturating
+//! map, offset); the terms are the additive ones (`c·|ẋ|ẋ`, `m·ẍ`, `c_ω·ω`, …) and the
+//! multiplicative ones, a parameter scaled by a slow or auxiliary signal (`m·(θ − θ̄)`).
+//!
+//! A refit is a damped Gauss–Newton step on θ jointly with the least-squares β: the base
+//! model's Jacobian by forward differences through the f32 core (one run per free
+//! parameter, in parallel), the normal equations solved on the training rows, the step
+//! halved until the true (nonlinear) training cost drops, then β solved again at the new
+//! θ. The reference the gain is measured against is refitted the same way without the new
+//! term, so a gain is never the extra Gauss–Newton step.
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::ident::fit::simulate::{kinematics, Simulator};
+use crate::ident::fit::spec::{ModelSpec, Spacing};
+use crate::ident::fit::Dataset;
+use crate::models::RateChoice;
+
+/// A change to what the base model is fed.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Transform {
+    /// The output responds to the input `delay_s` later: the model sees `x(t − delay_s)`.
+    Delay { delay_s: f64 },
+    /// First-order lag `τ·ẋ_f = x − x_f` (Spencer's η filter with η = 1/τ).
+    Lag { tau_s: f64 },
+    /// `b_s · tanh(x / b_s)`.
+    Saturate { b_sat: f64 },
+    /// The recorded input reads `b_0` high: the model sees `x − b_0`.
+    Offset { b_0: f64 },
+}
+
+impl Transform {
+    /// The transformed input; `dt` is the sample interval (s).
+    pub fn apply(&self, x: &[f64], dt: f64) -> Vec<f64> {
+        match *self {
+            Self::Delay { delay_s } => crate::ident::alignment::shift(x, -delay_s / dt),
+            Self::Lag { tau_s } => {
+                let a = if tau_s > 0.0 { (-dt / tau_s).exp() } else { 0.0 };
+                let mut f = x.first().copied().unwrap_or(0.0);
+                x.iter()
+                    .map(|v| {
+                        f = a * f + (1.0 - a) * v;
+                        f
+                    })
+                    .collect()
+            }
+            Self::Saturate { b_sat } => x.iter().map(|v| b_sat * (v / b_sat).tanh()).collect(),
+            Self::Offset { b_0 } => x.iter().map(|v| v - b_0).collect(),
+        }
+    }
+}
+
+/// One term linear in its coefficient.
+#[derive(Clone, Debug)]
+pub struct Term {
+    /// Name of the coefficient in the finding's `params`.
+    pub name: String,
+    /// `v_k` (one value per sample).
+    pub values: Vec<f64>,
+    /// When true the term is `m_θ · v_k` (a parameter of the base model scaled by `v_k`).
+    pub times_model: bool,
+}
+
+impl Term {
+    pub fn additive(name: impl Into<String>, values: Vec<f64>) -> Self {
+        Self { name: name.into(), values, times_model: false }
+    }
+    pub fn scaling(name: impl Into<String>, values: Vec<f64>) -> Self {
+        Self { name: name.into(), values, times_model: true }
+    }
+    fn column(&self, m: &[f64]) -> Vec<f64> {
+        if self.times_model {
+            self.values.iter().zip(m).map(|(v, m)| v * m).collect()
+        } else {
+            self.values.clone()
+        }
+    }
+}
+
+/// What stays fixed across every refit of one diagnosis.
+pub struct Problem<'a> {
+    pub data: &'a Dataset,
+    pub sim: &'a dyn Simulator,
+    pub spec: &'a ModelSpec,
+    pub rate: RateChoice,
+    /// Training rows the refit uses (flagged samples and delay-uncovered edges left out).
+    pub train: Vec<usize>,
+}
+
+/// A refitted augmented model.
+#[derive(Clone, Debug)]
+pub struct Fitted {
+    pub transforms: Vec<Transform>,
+    pub terms: Vec<Term>,
+    pub theta: Vec<f64>,
+    pub beta: Vec<f64>,
+    /// The base model's output (through the transforms) over the whole recording.
+    pub model: Vec<f64>,
+    /// The full prediction over the whole recording.
+    pub pred: Vec<f64>,
+    /// Mean squared error on the training rows.
+    pub train_mse: f64,
+}
+
+impl Fitted {
+    /// Free coefficients this model adds to the base model's.
+    pub fn extra_params(&self) -> usize {
+        self.terms.len() + self.transforms.len()
+    }
+}
+
+/// Builds what a candidate adds at its value `g`: an input transform and/or terms.
+pub type PieceFn<'a> = dyn Fn(f64) -> (Option<Transform>, Vec<Term>) + Sync + 'a;
+
+/// The tunable value of a candidate for [`Problem::refit`]: its builder, its start and box.
+pub struct Tune<'a> {
+    pub build: &'a PieceFn<'a>,
+    pub start: f64,
+    pub lo: f64,
+    pub hi: f64,
+    /// Searched on a log scale (time constants, levels).
+    pub log: bool,
+}
+
+/// The augmented model as a [`Simulator`] for the fit's Levenberg–Marquardt: parameters are
+/// the base model's θ followed by the candidate's value `g` (when it has one); β is solved
+/// by least squares inside every run (variable projection), so the optimiser only sees θ
+/// and `g`.
+struct AugSim<'p, 'a> {
+    prob: &'p Problem<'a>,
+    transforms: &'p [Transform],
+    terms: &'p [Term],
+    tune: Option<&'p Tune<'p>>,
+    /// Kinematics and the candidate's terms for the last `g` asked for.
+    cache: std::sync::Mutex<Option<CachedPiece>>,
+}
+
+/// Kinematics, transforms and terms at one tuning value.
+type Piece = (Vec<model_core::Kin>, Vec<Transform>, Vec<Term>);
+type CachedPiece = (u64, std::sync::Arc<Piece>);
+/// Base output, β, prediction, its mean squared error, transforms and terms (`AugSim::full`).
+type Full = (Vec<f64>, Vec<f64>, Vec<f64>, f64, Vec<Transform>, Vec<Term>);
+
+impl AugSim<'_, '_> {
+    fn n_base(&self) -> usize {
+        self.prob.sim.n_params()
+    }
+    /// Kinematics, transforms and terms at `g`.
+    fn at(&self, g: f64) -> Option<std::sync::Arc<Piece>> {
+        if let Ok(c) = self.cache.lock() {
+            if let Some((k, v)) = c.as_ref().filter(|(k, _)| *k == g.to_bits()) {
+                let _ = k;
+                return Some(std::sync::Arc::clone(v));
+            }
+        }
+        let mut transforms = self.transforms.to_vec();
+        let mut terms = self.terms.to_vec();
+        if let Some(t) = self.tune {
+            let (tr, extra) = (t.build)(g);
+            transforms.extend(tr);
+            terms.extend(extra);
+        }
+        let kin = self.prob.kin(&transforms)?;
+        let v = std::sync::Arc::new((kin, transforms, terms));
+        if let Ok(mut c) = self.cache.lock() {
+            *c = Some((g.to_bits(), std::sync::Arc::clone(&v)));
+        }
+        Some(v)
+    }
+    /// The base output, β and the prediction over the whole recording for `p`.
+    fn full(&self, p: &[f64]) -> Option<Full> {
+        let theta = p.get(..self.n_base())?;
+        let g = p.get(self.n_base()).copied().unwrap_or(0.0);
+        let piece = self.at(g)?;
+        let (kin, transforms, terms) = &*piece;
+        let m = self.prob.run_kin(theta, kin)?;
+        let (beta, pred, mse) = self.prob.solve_terms(terms, &m)?;
+        Some((m, beta, pred, mse, transforms.clone(), terms.clone()))
+    }
+}
+
+impl Simulator for AugSim<'_, '_> {
+    fn id(&self) -> &'static str {
+        self.prob.sim.id()
+    }
+    fn n_params(&self) -> usize {
+        self.n_base() + usize::from(self.tune.is_some())
+    }
+    fn valid(&self, p: &[f64]) -> bool {
+        p.get(..self.n_base()).is_some_and(|t| self.prob.sim.valid(t))
+    }
+    fn run(&self, p: &[f64], _kin: &[model_core::Kin], out: &mut [f64]) -> bool {
+        // Only the samples the objective scores (up to its last training row).
+        let (Some(theta), Some(piece)) =
+            (p.get(..self.n_base()), self.at(p.get(self.n_base()).copied().unwrap_or(0.0)))
+        else {
+            return false;
+        };
+        let (kin, _, terms) = &*piece;
+        let Some(m) = kin.get(..out.len()).and_then(|k| self.prob.run_kin(theta, k)) else { return false };
+        let Some((_, pred, _)) = self.prob.solve_terms(terms, &m) else { return false };
+        for (o, v) in out.iter_mut().zip(&pred) {
+            *o = *v;
+        }
+        pred.iter().all(|v| v.is_finite())
+    }
+}
+
+impl Problem<'_> {
+    /// The base model's output for `theta` fed the transformed input (`None` if it diverges).
+    pub fn run(&self, theta: &[f64], transforms: &[Transform]) -> Option<Vec<f64>> {
+        let kin = self.kin(transforms)?;
+        self.run_kin(theta, &kin)
+    }
+
+    fn kin(&self, transforms: &[Transform]) -> Option<Vec<model_core::Kin>> {
+        let mut x = self.data.input.clone();
+        for t in transforms {
+            x = t.apply(&x, self.data.dt);
+        }
+        // Given rates are the zero-phase ones: recomputed for the transformed input.
+        let rates = self.data.rates.as_ref().map(|_| crate::numerics::derivative::rates(&x, self.data.dt));
+        let samples = crate::models::replay::samples_with_rates(&x, self.data.command.as_deref(), rates.as_ref());
+        kinematics(&samples, self.data.dt as f32, self.rate)
+    }
+
+    fn run_kin(&self, theta: &[f64], kin: &[model_core::Kin]) -> Option<Vec<f64>> {
+        let mut out = vec![0.0; kin.len()];
+        self.sim.run(theta, kin, &mut out).then_some(out)
+    }
+
+    /// Forward-difference columns `∂m/∂θ_j` for the free parameters.
+    fn jacobian(&self, theta: &[f64], kin: &[model_core::Kin], m0: &[f64]) -> Vec<Vec<f64>> {
+        self.spec
+            .free()
+            .par_iter()
+            .filter_map(|&j| {
+                let ps = self.spec.params.get(j)?;
+                let v = *theta.get(j)?;
+                let h = match ps.spacing {
+                    Spacing::Linear => 1e-4 * (ps.hi - ps.lo),
+                    Spacing::Log => 1e-3 * v.abs().max(ps.lo),
+                };
+                let h = if v + h > ps.hi { -h } else { h };
+                let mut p = theta.to_vec();
+                p[j] = v + h;
+                let m = self.run_kin(&p, kin)?;
+                Some(m.iter().zip(m0).map(|(a, b)| (a - b) / h).collect())
+            })
+            .collect()
+    }
+
+    /// Least squares of `target` on `columns` over `rows`: coefficients and the training MSE.
+    /// Columns are scaled to unit norm and the normal equations get a tiny ridge, so a
+    /// column that duplicates another costs nothing instead of breaking the solve.
+    pub fn lsq(&self, columns: &[&[f64]], target: &[f64], rows: &[usize]) -> Option<(Vec<f64>, f64)> {
+        let k = columns.len();
+        let n = rows.len().max(1) as f64;
+        if k == 0 {
+            let mse = rows.iter().map(|&i| target[i] * target[i]).sum::<f64>() / n;
+            return Some((Vec::new(), mse));
+        }
+        let norms: Vec<f64> = columns
+            .iter()
+            .map(|c| rows.iter().map(|&i| c[i] * c[i]).sum::<f64>().sqrt())
+            .map(|s| if s > 0.0 && s.is_finite() { s } else { 1.0 })
+            .collect();
+        let mut g = nalgebra::DMatrix::<f64>::zeros(k, k);
+        let mut b = nalgebra::DVector::<f64>::zeros(k);
+        let mut row = vec![0.0; k];
+        for &i in rows {
+            for (r, (c, s)) in row.iter_mut().zip(columns.iter().zip(&norms)) {
+                *r = c[i] / s;
+            }
+            let t = target[i];
+            for a in 0..k {
+                let ra = row[a];
+                b[a] += ra * t;
+                for c in a..k {
+                    g[(a, c)] += ra * row[c];
+                }
+            }
+        }
+        for a in 0..k {
+            for c in 0..a {
+                g[(a, c)] = g[(c, a)];
+            }
+            g[(a, a)] += 1e-10;
+        }
+        let sol = g.clone().cholesky().map(|ch| ch.solve(&b)).or_else(|| g.svd(true, true).solve(&b, 1e-12).ok())?;
+        let coef: Vec<f64> = sol.iter().zip(&norms).map(|(v, s)| v / s).collect();
+        if coef.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let mse = rows
+            .iter()
+            .map(|&i| {
+                let f: f64 = columns.iter().zip(&coef).map(|(c, w)| c[i] * w).sum();
+                (target[i] - f).powi(2)
+            })
+            .sum::<f64>()
+            / n;
+        Some((coef, mse))
+    }
+
+    /// β for fixed θ (model output `m`): least squares of `y − m` on the terms' columns.
+    fn solve_terms(&self, terms: &[Term], m: &[f64]) -> Option<(Vec<f64>, Vec<f64>, f64)> {
+        let cols: Vec<Vec<f64>> = terms.iter().map(|t| t.column(m)).collect();
+        let target: Vec<f64> = self.data.output.iter().zip(m).map(|(y, m)| y - m).collect();
+        let refs: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
+        let (beta, mse) = self.lsq(&refs, &target, &self.train)?;
+        let mut pred = m.to_vec();
+        for (c, b) in cols.iter().zip(&beta) {
+            for (p, v) in pred.iter_mut().zip(c) {
+                *p += b * v;
+            }
+        }
+        Some((beta, pred, mse))
+    }
+
+    /// Refit θ, β and the candidate's value of the model `transforms` + `terms` (+ what
+    /// `tune` builds), from `theta` (and `tune.start`), by the fit's bounded
+    /// Levenberg–Marquardt with at most `iterations` Jacobians. Returns the fit and the
+    /// candidate's final value (0 without one); `None` when the start diverges.
+    pub fn refit(
+        &self,
+        transforms: &[Transform],
+        terms: &[Term],
+        tune: Option<&Tune<'_>>,
+        theta: &[f64],
+        iterations: usize,
+    ) -> Option<(Fitted, f64)> {
+        let aug = AugSim { prob: self, transforms, terms, tune, cache: std::sync::Mutex::new(None) };
+        let mut spec = self.spec.clone();
+        let mut start = theta.to_vec();
+        if let Some(t) = tune {
+            let (lo, hi) = (t.lo.min(t.hi), t.hi.max(t.lo));
+            spec.params.push(crate::ident::fit::spec::ParamSpec {
+                name: "candidate",
+                lo,
+                hi,
+                start: t.start.clamp(lo, hi),
+                spacing: if t.log && lo > 0.0 { Spacing::Log } else { Spacing::Linear },
+                fixed: false,
+            });
+            start.push(t.start.clamp(lo, hi));
+        }
+        let p = if iterations == 0 {
+            start
+        } else {
+            let kin = self.kin(&[])?;
+            let scale = {
+                let ys: Vec<f64> = self.train.iter().filter_map(|&i| self.data.output.get(i).copied()).collect();
+                let m = ys.iter().sum::<f64>() / ys.len().max(1) as f64;
+                (ys.iter().map(|v| (v - m).powi(2)).sum::<f64>() / ys.len().max(1) as f64).sqrt()
+            };
+            let obj =
+                crate::ident::fit::objective::Objective::new(&aug, &spec, &kin, &self.data.output, &self.train, scale);
+            let r = crate::ident::fit::lm::minimize(&obj, &start, iterations);
+            if r.cost.is_finite() && r.cost <= obj.cost(&start) {
+                r.params
+            } else {
+                start
+            }
+        };
+        let (m, beta, pred, mse, transforms, terms) = aug.full(&p)?;
+        let g = p.get(self.sim.n_params()).copied().unwrap_or(0.0);
+        let theta = p.get(..self.sim.n_params())?.to_vec();
+        Some((Fitted { transforms, terms, theta, beta, model: m, pred, train_mse: mse }, g))
+    }
+
+    /// Training MSE of `transforms` + `terms` linearised about `theta`: the base model's
+    /// Jacobian `jac` (taken at the current transforms) stands in for the refit of θ. One
+    /// run of the base model, for scanning a candidate's grid cheaply.
+    pub fn scan_cost(&self, transforms: &[Transform], terms: &[Term], theta: &[f64], jac: &[Vec<f64>]) -> Option<f64> {
+        let m = self.run(theta, transforms)?;
+        let term_cols: Vec<Vec<f64>> = terms.iter().map(|t| t.column(&m)).collect();
+        let cols: Vec<&[f64]> = jac.iter().chain(&term_cols).map(Vec::as_slice).collect();
+        let target: Vec<f64> = self.data.output.iter().zip(&m).map(|(y, m)| y - m).collect();
+        self.lsq(&cols, &target, &self.train).map(|(_, mse)| mse)
+    }
+
+    /// The base model's Jacobian at `theta` through `transforms`.
+    pub fn jacobian_at(&self, theta: &[f64], transforms: &[Transform]) -> Option<Vec<Vec<f64>>> {
+        let kin = self.kin(transforms)?;
+        let m0 = self.run_kin(theta, &kin)?;
+        Some(self.jacobian(theta, &kin, &m0))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn transforms_do_what_they_say() {
+        let dt = 1e-3;
+        let x: Vec<f64> = (0..200).map(|i| (i as f64 * 0.05).sin()).collect();
+        // A delay of 3 samples: the model sees x three samples earlier.
+        let d = Transform::Delay { delay_s: 3e-3 }.apply(&x, dt);
+        assert!((d[50] - x[47]).abs() < 1e-12);
+        // A first-order lag keeps a constant and attenuates a step's start.
+        let step: Vec<f64> = (0..100).map(|i| if i < 10 { 0.0 } else { 1.0 }).collect();
+        let l = Transform::Lag { tau_s: 5e-3 }.apply(&step, dt);
+        assert!((l[14] - (1.0 - (-5.0f64 / 5.0).exp())).abs() < 1e-9, "{}", l[14]);
+        assert!((l[99] - 1.0).abs() < 1e-6);
+        let s = Transform::Saturate { b_sat: 0.5 }.apply(&[2.0, -2.0, 0.0], dt);
+        assert!(s[0] < 0.5 && s[0] > 0.49 && s[1] == -s[0] && s[2] == 0.0);
+        assert_eq!(Transform::Offset { b_0: 0.1 }.apply(&[1.0], dt), vec![0.9]);
+    }
+}

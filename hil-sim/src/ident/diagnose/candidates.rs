@@ -1,0 +1,395 @@
+//! The catalog's candidate causes (shared/spec/physics-catalog.md), each as the term that
+//! models it, with a one-dimensional grid for the value the term cannot fit linearly (a
+//! time constant, a delay, a saturation level, an offset).
+//!
+//! Auxiliary channels are used only when the recording has them. Each is first classified
+//! from its data and its name ([`classify`]):
+//!
+//! - a copy of the input's rate (|corr(a, ẋ)| ≥ 0.9, e.g. the Dyke files' `V`): the model
+//!   already has the rate; not a cause;
+//! - the input's acceleration (|corr(a, ẍ)| ≥ 0.6, e.g. the Dyke files' `A`): the `inertia`
+//!   regressor, measured instead of differentiated twice;
+//! - a temperature (name `temp…`, `theta`, `oil`): the `thermal_drift` state;
+//! - a speed (name `speed`, `omega`, `rpm`, `slip`, `w`): `slip_speed`, and its derivative
+//!   for `inertia` (the output rotor's inertia seen by the torque sensor);
+//! - anything else that varies (a coil current, a command voltage): `aux_dependence`.
+
+use serde::Serialize;
+
+use super::augment::{Term, Transform};
+use crate::ident::fit::Dataset;
+
+/// What an auxiliary channel was taken to be.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    /// A copy of the input's rate: not used.
+    InputRate,
+    InputAcceleration,
+    Temperature,
+    Speed,
+    Auxiliary,
+    /// Constant, mostly missing, or the model's own command: not used.
+    Unused,
+}
+
+/// An auxiliary channel and its role.
+#[derive(Clone, Debug, Serialize)]
+pub struct AuxChannel {
+    pub name: String,
+    pub role: Role,
+    #[serde(skip)]
+    pub values: Vec<f64>,
+}
+
+/// One candidate: its catalog effect, a label naming the channel it uses, the grid of its
+/// nonlinear value and how to build the piece at each grid value.
+pub struct Candidate {
+    pub effect: &'static str,
+    pub label: String,
+    /// Name and unit of the grid value in the finding's params (`tau_s`, …); `None` when the
+    /// candidate has no grid.
+    pub grid_name: Option<String>,
+    pub grid: Vec<f64>,
+    /// Builds the piece at a grid value.
+    pub build: Box<dyn Fn(f64) -> Piece + Sync + Send>,
+    /// The auxiliary channel it uses, if any.
+    pub channel: Option<String>,
+}
+
+/// What a candidate adds: an input transform and/or terms.
+#[derive(Clone, Debug)]
+pub struct Piece {
+    pub transform: Option<Transform>,
+    pub terms: Vec<Term>,
+}
+
+fn corr(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    if n < 3 {
+        return 0.0;
+    }
+    let (ma, mb) = (a[..n].iter().sum::<f64>() / n as f64, b[..n].iter().sum::<f64>() / n as f64);
+    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+    for (x, y) in a[..n].iter().zip(&b[..n]) {
+        sab += (x - ma) * (y - mb);
+        saa += (x - ma) * (x - ma);
+        sbb += (y - mb) * (y - mb);
+    }
+    if saa > 0.0 && sbb > 0.0 {
+        sab / (saa * sbb).sqrt()
+    } else {
+        0.0
+    }
+}
+
+fn mean(v: &[f64]) -> f64 {
+    v.iter().sum::<f64>() / v.len().max(1) as f64
+}
+
+fn std(v: &[f64]) -> f64 {
+    let m = mean(v);
+    (v.iter().map(|a| (a - m) * (a - m)).sum::<f64>() / v.len().max(1) as f64).sqrt()
+}
+
+fn centred(v: &[f64]) -> Vec<f64> {
+    let m = mean(v);
+    v.iter().map(|a| a - m).collect()
+}
+
+/// A causal first-order low-pass with time constant `tau_s` (0: unchanged).
+fn lowpass(v: &[f64], tau_s: f64, dt: f64) -> Vec<f64> {
+    Transform::Lag { tau_s }.apply(v, dt)
+}
+
+/// The input's rate and acceleration: the given ones, else the zero-phase offline ones.
+pub fn rates(data: &Dataset) -> (Vec<f64>, Vec<f64>) {
+    data.rates.clone().unwrap_or_else(|| crate::numerics::derivative::rates(&data.input, data.dt))
+}
+
+/// Correlation of `v` with the input's acceleration `ddx` beyond what the input `x` itself
+/// explains (partial correlation given `x`). A channel that mostly follows the input (a
+/// coil current next to its field) correlates with `ẍ` under a band-limited input only
+/// through `x` (for a narrow band `ẍ ≈ −ω²x`); a measured acceleration keeps its correlation
+/// once `x` is taken out. Falls back to the plain correlation when `ẍ` is `x` up to a
+/// factor (a pure sine).
+fn acceleration_corr(v: &[f64], x: &[f64], ddx: &[f64]) -> f64 {
+    let (r_vd, r_vx, r_dx) = (corr(v, ddx), corr(v, x), corr(ddx, x));
+    let den = ((1.0 - r_vx * r_vx) * (1.0 - r_dx * r_dx)).sqrt();
+    if 1.0 - r_dx * r_dx < 1e-4 || den <= 1e-12 {
+        r_vd
+    } else {
+        (r_vd - r_vx * r_dx) / den
+    }
+}
+
+/// Classify the recording's auxiliary channels `aux` (name, values).
+pub fn classify(data: &Dataset, aux: Vec<(String, Vec<f64>)>, command: Option<&str>) -> Vec<AuxChannel> {
+    let (dx, ddx) = rates(data);
+    aux.into_iter()
+        .map(|(name, values)| {
+            let finite = values.iter().filter(|v| v.is_finite()).count();
+            let lower = name.to_lowercase();
+            let role = if command == Some(name.as_str())
+                || finite + finite / 50 < values.len()
+                || std(&values) <= 1e-12 * mean(&values).abs().max(1e-300)
+            {
+                Role::Unused
+            } else if corr(&values, &dx).abs() >= 0.9 {
+                Role::InputRate
+            } else if acceleration_corr(&values, &data.input, &ddx).abs() >= 0.6 {
+                Role::InputAcceleration
+            } else if ["temp", "theta", "oil", "therm"].iter().any(|k| lower.contains(k)) {
+                Role::Temperature
+            } else if ["speed", "omega", "rpm", "slip"].iter().any(|k| lower.contains(k)) || lower == "w" {
+                Role::Speed
+            } else {
+                Role::Auxiliary
+            };
+            // Non-finite entries (a channel logged on the first row only) are not used.
+            let values = if role == Role::Unused { values } else { fill(values) };
+            AuxChannel { name, role, values }
+        })
+        .collect()
+}
+
+/// Replace non-finite entries by the previous finite value.
+fn fill(mut v: Vec<f64>) -> Vec<f64> {
+    let mut last = v.iter().copied().find(|a| a.is_finite()).unwrap_or(0.0);
+    for a in &mut v {
+        if a.is_finite() {
+            last = *a;
+        } else {
+            *a = last;
+        }
+    }
+    v
+}
+
+/// A log-spaced grid of `n` values from `lo` to `hi`.
+fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    (0..n).map(|k| lo * (hi / lo).powf(k as f64 / (n - 1).max(1) as f64)).collect()
+}
+
+/// Every candidate for this recording.
+pub fn all(data: &Dataset, aux: &[AuxChannel]) -> Vec<Candidate> {
+    let dt = data.dt;
+    let fs = 1.0 / dt;
+    let x = data.input.clone();
+    let (dx, ddx) = rates(data);
+    let x_max = x.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
+    let x_span = {
+        let (lo, hi) = x.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+        (hi - lo).max(1e-300)
+    };
+    let x_mean = mean(&x);
+    let dx_std = std(&dx).max(1e-300);
+    let mut out = Vec::new();
+
+    // Phase: a first-order lag and a pure delay, 1 sample to 50 ms.
+    out.push(Candidate {
+        effect: "field_lag",
+        label: "first-order lag of the input".into(),
+        grid_name: Some("tau_s".into()),
+        grid: log_grid(dt, (0.05f64).max(4.0 * dt), 14),
+        build: Box::new(|tau| Piece { transform: Some(Transform::Lag { tau_s: tau }), terms: vec![] }),
+        channel: None,
+    });
+    let max_delay = (0.02 * fs).round().clamp(4.0, 40.0);
+    out.push(Candidate {
+        effect: "transport_delay",
+        label: "time shift between input and output".into(),
+        grid_name: Some("delay_s".into()),
+        grid: (-(max_delay as i64)..=max_delay as i64).filter(|k| *k != 0).map(|k| k as f64 * dt).collect(),
+        build: Box::new(|d| Piece { transform: Some(Transform::Delay { delay_s: d }), terms: vec![] }),
+        channel: None,
+    });
+    // Amplitude: a saturating map and a zero offset of the input.
+    out.push(Candidate {
+        effect: "saturation",
+        label: "saturating map of the input".into(),
+        grid_name: Some("b_sat".into()),
+        grid: log_grid(0.6 * x_max, 6.0 * x_max, 10),
+        build: Box::new(|b| Piece { transform: Some(Transform::Saturate { b_sat: b }), terms: vec![] }),
+        channel: None,
+    });
+    out.push(Candidate {
+        effect: "sensor_offset",
+        label: "zero offset of the input".into(),
+        grid_name: Some("b_0".into()),
+        grid: (-8..=8).filter(|k| *k != 0).map(|k| f64::from(k) * 0.01 * x_span).collect(),
+        build: Box::new(|b| Piece { transform: Some(Transform::Offset { b_0: b }), terms: vec![] }),
+        channel: None,
+    });
+    // Rate: c·|ẋ|ẋ.
+    let rate_term: Vec<f64> = dx.iter().map(|v| v.abs() * v).collect();
+    out.push(Candidate {
+        effect: "rate_dependence",
+        label: "term in |rate|·rate".into(),
+        grid_name: None,
+        grid: vec![0.0],
+        build: Box::new(move |_| Piece { transform: None, terms: vec![Term::additive("c_rate", rate_term.clone())] }),
+        channel: None,
+    });
+    // Direction: δ·(x − x̄)·sgn(ẋ), the sign smoothed over 5 % of the rate's spread.
+    let asym: Vec<f64> = x.iter().zip(&dx).map(|(x, d)| (x - x_mean) * (d / (0.05 * dx_std)).tanh()).collect();
+    out.push(Candidate {
+        effect: "asymmetry",
+        label: "loading/unloading difference growing with the input".into(),
+        grid_name: None,
+        grid: vec![0.0],
+        build: Box::new(move |_| Piece { transform: None, terms: vec![Term::additive("delta", asym.clone())] }),
+        channel: None,
+    });
+    // Inertia: m·ẍ, from a measured acceleration when there is one.
+    let acc = aux.iter().find(|a| a.role == Role::InputAcceleration);
+    let (acc_values, acc_label, acc_channel) = match acc {
+        Some(a) => {
+            (centred(&a.values), format!("inertial term m·{} (measured acceleration)", a.name), Some(a.name.clone()))
+        }
+        None => (ddx.clone(), "inertial term m·ẍ of the input".into(), None),
+    };
+    out.push(Candidate {
+        effect: "inertia",
+        label: acc_label,
+        grid_name: None,
+        grid: vec![0.0],
+        build: Box::new(move |_| Piece { transform: None, terms: vec![Term::additive("m", acc_values.clone())] }),
+        channel: acc_channel,
+    });
+    // Thermal drift: a temperature channel scales the model (and shifts its offset); without
+    // one, the dissipated energy does.
+    let temps: Vec<&AuxChannel> = aux.iter().filter(|a| a.role == Role::Temperature).collect();
+    if temps.is_empty() {
+        let energy = {
+            let mut e = 0.0;
+            let p: Vec<f64> = data.output.iter().zip(&dx).map(|(y, d)| (y * d).abs()).collect();
+            let mut v: Vec<f64> = p
+                .iter()
+                .map(|p| {
+                    e += p * dt;
+                    e
+                })
+                .collect();
+            let last = v.last().copied().unwrap_or(1.0).max(1e-300);
+            v.iter_mut().for_each(|a| *a /= last);
+            centred(&v)
+        };
+        out.push(Candidate {
+            effect: "thermal_drift",
+            label: "drift with the dissipated energy".into(),
+            grid_name: None,
+            grid: vec![0.0],
+            build: Box::new(move |_| Piece {
+                transform: None,
+                terms: vec![
+                    Term::scaling("kappa_energy", energy.clone()),
+                    Term::additive("offset_energy", energy.clone()),
+                ],
+            }),
+            channel: None,
+        });
+    }
+    for t in temps {
+        let v = centred(&t.values);
+        out.push(Candidate {
+            effect: "thermal_drift",
+            label: format!("drift with the channel {} (a temperature)", t.name),
+            grid_name: None,
+            grid: vec![0.0],
+            build: Box::new(move |_| Piece {
+                transform: None,
+                terms: vec![Term::scaling("kappa_per_unit", v.clone()), Term::additive("offset_per_unit", v.clone())],
+            }),
+            channel: Some(t.name.clone()),
+        });
+    }
+    for s in aux.iter().filter(|a| a.role == Role::Speed) {
+        let v = centred(&s.values);
+        let vb: Vec<f64> = v.iter().zip(&x).map(|(v, x)| v * x / x_max).collect();
+        out.push(Candidate {
+            effect: "slip_speed",
+            label: format!("viscous term in the channel {} (a speed)", s.name),
+            grid_name: None,
+            grid: vec![0.0],
+            build: Box::new(move |_| Piece {
+                transform: None,
+                terms: vec![Term::additive("c_omega", v.clone()), Term::additive("c_omega_field", vb.clone())],
+            }),
+            channel: Some(s.name.clone()),
+        });
+        let tau = 20.0 * dt / (2.0 * std::f64::consts::PI);
+        let smooth = crate::ident::alignment::shift(&lowpass(&s.values, tau, dt), tau / dt);
+        let acc = crate::models::replay::gradient(&smooth, dt);
+        out.push(Candidate {
+            effect: "inertia",
+            label: format!("inertial term J·d{}/dt", s.name),
+            grid_name: None,
+            grid: vec![0.0],
+            build: Box::new(move |_| Piece { transform: None, terms: vec![Term::additive("j", acc.clone())] }),
+            channel: Some(s.name.clone()),
+        });
+    }
+    for a in aux.iter().filter(|a| a.role == Role::Auxiliary) {
+        let raw = a.values.clone();
+        let dx = dx.clone();
+        let xc: Vec<f64> = x.iter().map(|v| v - x_mean).collect();
+        let mut grid = vec![0.0];
+        grid.extend(log_grid(dt, (0.05f64).max(4.0 * dt), 10));
+        out.push(Candidate {
+            effect: "aux_dependence",
+            label: format!("parameters scaled by {}", a.name),
+            grid_name: Some("lag_s".into()),
+            grid,
+            build: Box::new(move |tau| {
+                let u = centred(&lowpass(&raw, tau, dt));
+                let udx: Vec<f64> = u.iter().zip(&dx).map(|(u, d)| u * d).collect();
+                let ux: Vec<f64> = u.iter().zip(&xc).map(|(u, x)| u * x).collect();
+                Piece {
+                    transform: None,
+                    terms: vec![
+                        Term::scaling("alpha", u.clone()),
+                        Term::additive("offset", u),
+                        Term::additive("c_rate", udx),
+                        Term::additive("k_input", ux),
+                    ],
+                }
+            }),
+            channel: Some(a.name.clone()),
+        });
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A two-tone input, its exact acceleration, a coil-current-like channel (the input plus
+    /// a lead term) and a measured acceleration (the exact one plus noise).
+    fn signals() -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+        let (w1, w2, tau) = (std::f64::consts::TAU * 5.0, std::f64::consts::TAU * 7.0, 0.002);
+        let t: Vec<f64> = (0..20_000).map(|k| k as f64 * 5e-4).collect();
+        let x: Vec<f64> = t.iter().map(|t| (w1 * t).sin() + 0.5 * (w2 * t).sin()).collect();
+        let dx: Vec<f64> = t.iter().map(|t| w1 * (w1 * t).cos() + 0.5 * w2 * (w2 * t).cos()).collect();
+        let ddx: Vec<f64> = t.iter().map(|t| -w1 * w1 * (w1 * t).sin() - 0.5 * w2 * w2 * (w2 * t).sin()).collect();
+        let current: Vec<f64> = x.iter().zip(&dx).map(|(x, d)| 0.3 + x + tau * d).collect();
+        let accel: Vec<f64> = ddx
+            .iter()
+            .enumerate()
+            .map(|(k, a)| a + 200.0 * ((k as f64 * 12.9898).sin() * 43758.5453).fract())
+            .collect();
+        (x, ddx, current, accel)
+    }
+
+    #[test]
+    fn a_channel_following_the_input_is_not_its_acceleration() {
+        let (x, ddx, current, accel) = signals();
+        // Under a narrow band the plain correlation cannot tell them apart ...
+        assert!(corr(&current, &ddx).abs() > 0.6, "{}", corr(&current, &ddx));
+        assert!(corr(&accel, &ddx).abs() > 0.6);
+        // ... the correlation beyond the input can.
+        assert!(acceleration_corr(&current, &x, &ddx).abs() < 0.3, "{}", acceleration_corr(&current, &x, &ddx));
+        assert!(acceleration_corr(&accel, &x, &ddx).abs() > 0.6, "{}", acceleration_corr(&accel, &x, &ddx));
+    }
+}

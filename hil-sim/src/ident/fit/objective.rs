@@ -1,0 +1,132 @@
+//! The least-squares objective every optimiser shares: run the core over the training
+//! part, compare with the measurement on the rows that count.
+
+use std::sync::{Arc, Mutex};
+
+use model_core::Kin;
+
+use super::simulate::Simulator;
+use super::spec::ModelSpec;
+use crate::ident::alignment::{shift_kin, MAX_DELAY_SAMPLES};
+
+/// Kinematics shifted by an (input, command) delay pair, in samples.
+type ShiftedKin = ((f64, f64), Arc<Vec<Kin>>);
+
+/// Residuals of one model on one stretch of data.
+///
+/// The model runs over every sample from the start of `kin` (its state must see the
+/// whole history) but only `rows` (training samples not flagged by the quality checks)
+/// enter the sum. When the spec carries more entries than the model has parameters, the
+/// first is an input delay and the second a command delay, in samples
+/// ([`crate::ident::alignment`]), fitted with the rest. Residuals are divided by `scale` (the output's spread) so that the
+/// tolerances of the optimisers mean the same thing in every unit.
+pub struct Objective<'a> {
+    pub sim: &'a dyn Simulator,
+    pub spec: &'a ModelSpec,
+    /// The kinematics up to the last row, plus a margin for the delay to read ahead.
+    pub kin: &'a [Kin],
+    /// Samples the model runs over (one past the last row).
+    pub end: usize,
+    pub y: &'a [f64],
+    pub rows: &'a [usize],
+    pub scale: f64,
+    /// Indices of the free parameters.
+    pub free: Vec<usize>,
+    /// The kinematics shifted by the delays last asked for: a Jacobian's columns for the
+    /// model's own parameters all share one pair of delays.
+    shifted: Mutex<Option<ShiftedKin>>,
+}
+
+impl<'a> Objective<'a> {
+    pub fn new(
+        sim: &'a dyn Simulator,
+        spec: &'a ModelSpec,
+        kin: &'a [Kin],
+        y: &'a [f64],
+        rows: &'a [usize],
+        scale: f64,
+    ) -> Self {
+        let end = rows.last().map_or(0, |r| r + 1).min(kin.len());
+        let ext = (end + MAX_DELAY_SAMPLES.ceil() as usize + 1).min(kin.len());
+        Self {
+            sim,
+            spec,
+            kin: &kin[..ext],
+            end,
+            y,
+            rows,
+            scale: scale.max(1e-300),
+            free: spec.free(),
+            shifted: Mutex::new(None),
+        }
+    }
+
+    /// The model's own parameters of a full vector `p` (without the delay entry).
+    pub fn model_params<'p>(&self, p: &'p [f64]) -> &'p [f64] {
+        p.get(..self.sim.n_params()).unwrap_or(p)
+    }
+
+    /// The input and command delays in samples that `p` carries (0 when the spec has none).
+    pub fn delays(&self, p: &[f64]) -> (f64, f64) {
+        let n = self.sim.n_params();
+        (p.get(n).copied().unwrap_or(0.0), p.get(n + 1).copied().unwrap_or(0.0))
+    }
+
+    /// The full parameter vector for free-parameter positions `unit` (each in [0, 1] of its box).
+    pub fn from_unit(&self, unit: &[f64]) -> Vec<f64> {
+        let mut p = self.spec.start();
+        for (&j, s) in self.free.iter().zip(unit) {
+            if let (Some(v), Some(ps)) = (p.get_mut(j), self.spec.params.get(j)) {
+                *v = ps.from_unit(*s);
+            }
+        }
+        p
+    }
+
+    /// Box positions of the free parameters of `p`.
+    pub fn to_unit(&self, p: &[f64]) -> Vec<f64> {
+        self.free.iter().filter_map(|&j| Some(self.spec.params.get(j)?.to_unit(*p.get(j)?))).collect()
+    }
+
+    /// Scaled residuals at `p`, `None` when the model rejects `p` or diverges.
+    pub fn residuals(&self, p: &[f64]) -> Option<Vec<f64>> {
+        let mut out = vec![0.0; self.end];
+        let (d, d_u) = self.delays(p);
+        let ok = if d == 0.0 && d_u == 0.0 {
+            self.sim.run(self.model_params(p), self.kin.get(..self.end)?, &mut out)
+        } else {
+            let shifted = self.shifted_by(d, d_u);
+            self.sim.run(self.model_params(p), shifted.get(..self.end)?, &mut out)
+        };
+        if !ok {
+            return None;
+        }
+        let inv = 1.0 / self.scale;
+        self.rows.iter().map(|&i| Some((out.get(i)? - self.y.get(i)?) * inv)).collect()
+    }
+
+    /// The kinematics shifted by `(d, d_u)` samples, from the cache when the delays are the
+    /// ones last asked for.
+    fn shifted_by(&self, d: f64, d_u: f64) -> Arc<Vec<Kin>> {
+        if let Ok(cache) = self.shifted.lock() {
+            if let Some((_, kin)) = cache.as_ref().filter(|(key, _)| *key == (d, d_u)) {
+                return Arc::clone(kin);
+            }
+        }
+        let mut shifted = Vec::with_capacity(self.kin.len());
+        shift_kin(self.kin, d, d_u, &mut shifted);
+        let shifted = Arc::new(shifted);
+        if let Ok(mut cache) = self.shifted.lock() {
+            *cache = Some(((d, d_u), Arc::clone(&shifted)));
+        }
+        shifted
+    }
+
+    /// Mean squared scaled residual (∞ when invalid).
+    pub fn cost(&self, p: &[f64]) -> f64 {
+        match self.residuals(p) {
+            Some(r) if !r.is_empty() => r.iter().map(|v| v * v).sum::<f64>() / r.len() as f64,
+            _ => f64::INFINITY,
+        }
+    }
+}

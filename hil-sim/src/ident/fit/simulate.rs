@@ -1,0 +1,134 @@
+//! The model-core step, driven by the optimisers: a flat `f64` parameter vector in, the
+//! model's f32 output over a run of precomputed kinematics out.
+//!
+//! The kinematics (`x, ẋ, ẍ, u`) come from the same rate estimator the firmware runs
+//! ([`kinematics`]); they do not depend on the parameters, so they are computed once per fit.
+
+use std::marker::PhantomData;
+
+use model_core::rate::RateState;
+use model_core::{Kin, Model, Sample};
+
+use crate::models::{visit, RateChoice, Visit};
+
+/// Runs one model type, chosen at run time by id.
+pub trait Simulator: Send + Sync {
+    fn id(&self) -> &'static str;
+    fn n_params(&self) -> usize;
+    /// Whether `p` is a valid parameter set (the model's own constructor decides).
+    fn valid(&self, p: &[f64]) -> bool;
+    /// Run from rest over `kin`, writing one output per sample into `out`. `false` when the
+    /// parameters are invalid or the output stops being finite.
+    fn run(&self, p: &[f64], kin: &[Kin], out: &mut [f64]) -> bool;
+}
+
+struct Sim<M> {
+    dt: f32,
+    _m: PhantomData<fn() -> M>,
+}
+
+fn to_f32(p: &[f64]) -> Vec<f32> {
+    p.iter().map(|v| *v as f32).collect()
+}
+
+impl<M: Model> Simulator for Sim<M> {
+    fn id(&self) -> &'static str {
+        M::ID
+    }
+    fn n_params(&self) -> usize {
+        M::N_PARAMS
+    }
+    fn valid(&self, p: &[f64]) -> bool {
+        M::from_params(&to_f32(p), self.dt).is_ok()
+    }
+    fn run(&self, p: &[f64], kin: &[Kin], out: &mut [f64]) -> bool {
+        let Ok(model) = M::from_params(&to_f32(p), self.dt) else { return false };
+        let Some(first) = kin.first() else { return true };
+        let mut st = model.initial_state(first);
+        for (k, o) in kin.iter().zip(out.iter_mut()) {
+            let y = model.step(&mut st, k);
+            if !y.is_finite() {
+                return false;
+            }
+            *o = f64::from(y);
+        }
+        true
+    }
+}
+
+struct Make(f32);
+impl Visit for Make {
+    type Out = Box<dyn Simulator>;
+    fn visit<M: Model>(self) -> Box<dyn Simulator> {
+        Box::new(Sim::<M> { dt: self.0, _m: PhantomData })
+    }
+}
+
+/// The simulator of model `id` at step `dt` seconds; `None` for an unknown id.
+pub fn simulator(id: &str, dt: f32) -> Option<Box<dyn Simulator>> {
+    visit(id, Make(dt))
+}
+
+/// The simulator of a model type that is not in the registry (e.g. a smaller size of a
+/// const-generic model, trained before it is written into the registered size).
+pub fn simulator_of<M: Model>(dt: f32) -> Box<dyn Simulator> {
+    Box::new(Sim::<M> { dt, _m: PhantomData })
+}
+
+/// The kinematics the core sees for each sample, from the rate estimator `rate` exactly as
+/// [`model_core::Estimator::step`] computes them (a measured rate in the sample wins).
+/// `None` if the estimate overflows (the inputs are checked finite before).
+pub fn kinematics(samples: &[Sample], dt: f32, rate: RateChoice) -> Option<Vec<Kin>> {
+    let params = rate.build(dt).ok()?;
+    let mut st = RateState::default();
+    let mut out = Vec::with_capacity(samples.len());
+    for s in samples {
+        let (dx, ddx) = params.step(&mut st, s.x);
+        let k = Kin { x: s.x, dx: s.dx.unwrap_or(dx), ddx: s.ddx.unwrap_or(ddx), u: s.u.unwrap_or(0.0) };
+        if !k.is_finite() {
+            return None;
+        }
+        out.push(k);
+    }
+    Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::replay;
+
+    #[test]
+    fn matches_the_estimator_replay() {
+        let dt = 1e-3f32;
+        let samples: Vec<Sample> = (0..2000)
+            .map(|i| {
+                let t = i as f32 * dt;
+                Sample::new(2.0 * (7.0 * t).sin() + 0.3 * (31.0 * t).sin()).with_command(1.0 + 0.5 * (3.0 * t).sin())
+            })
+            .collect();
+        let spencer = [21.0, 3.5, 46.9, 283.0, 2.95, 5.0, 14.3, 140.0, 695.0, 363.0, 363.0, 301.0, 2.0, 190.0];
+        for rate in [RateChoice::Backward, RateChoice::Filtered(50.0)] {
+            let kin = kinematics(&samples, dt, rate).unwrap();
+            let sim = simulator("spencer", dt).unwrap();
+            let mut out = vec![0.0; kin.len()];
+            let p: Vec<f64> = spencer.iter().map(|v| f64::from(*v)).collect();
+            assert!(sim.run(&p, &kin, &mut out));
+            let want = replay("spencer", &spencer, dt, rate, &samples).unwrap();
+            for (a, b) in out.iter().zip(&want.y) {
+                assert_eq!(*a, f64::from(*b));
+            }
+        }
+    }
+
+    #[test]
+    fn invalid_parameters_are_reported() {
+        let sim = simulator("bouc_wen", 1e-3).unwrap();
+        let kin = vec![Kin::default(); 4];
+        let mut out = vec![0.0; 4];
+        // n = 0 is outside the model's bounds.
+        assert!(!sim.run(&[1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0], &kin, &mut out));
+        assert!(!sim.valid(&[1.0]));
+        assert!(simulator("nope", 1e-3).is_none());
+    }
+}

@@ -1,0 +1,7 @@
+//! Identification: fit a model to recordings, compare models across recordings, diagnose
+//! what a model misses.
+
+pub mod alignment;
+pub mod compare;
+pub mod diagnose;
+pub mod fit;

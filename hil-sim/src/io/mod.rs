@@ -1,0 +1,7 @@
+//! Files in and out: recordings (CSV, MAT), parameter files, the firmware's configuration
+//! page, and where the bundled laboratory data lives.
+
+pub mod bundled;
+pub mod config_page;
+pub mod params_file;
+pub mod recording;

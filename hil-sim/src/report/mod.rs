@@ -1,0 +1,252 @@
+//! A small Markdown report: headings, paragraphs, tables and figures, written as
+//! `report.md` and as `index.html` (the same Markdown rendered by pulldown-cmark, with SVG
+//! figures found beside the report inlined so the page stands alone).
+//!
+//! ```no_run
+//! # use hil_sim::report::Report;
+//! let mut r = Report::new("Fit of ranran_50");
+//! r.heading("Held-out error")
+//!     .paragraph("Time-ordered split, last 15 % held out.")
+//!     .table(&["model", "RMSE (N)"], &[vec!["spencer".to_owned(), "196.5".to_owned()]])
+//!     .image("loop.svg", "Force against displacement");
+//! r.write("target/report").unwrap();
+//! ```
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use pulldown_cmark::{html, CowStr, Event, Options, Parser, Tag, TagEnd};
+use thiserror::Error;
+
+/// Why a report was not written.
+#[derive(Debug, Error)]
+pub enum ReportError {
+    #[error("writing {path}: {source}")]
+    Io { path: PathBuf, source: std::io::Error },
+}
+
+/// A report under construction; see the module docs.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Report {
+    title: String,
+    md: String,
+}
+
+impl Report {
+    pub fn new(title: impl Into<String>) -> Self {
+        let title = title.into();
+        let md = format!("# {}\n\n", one_line(&title));
+        Self { title, md }
+    }
+
+    pub fn title(&self) -> &str {
+        &self.title
+    }
+
+    /// A section heading (`##`).
+    pub fn heading(&mut self, text: &str) -> &mut Self {
+        self.heading_level(2, text)
+    }
+
+    /// A heading of level 1–6 (clamped).
+    pub fn heading_level(&mut self, level: usize, text: &str) -> &mut Self {
+        let hashes = "#".repeat(level.clamp(1, 6));
+        let _ = write!(self.md, "{hashes} {}\n\n", one_line(text));
+        self
+    }
+
+    /// A paragraph of Markdown text (inline markup such as `*em*` or `` `code` `` is kept).
+    pub fn paragraph(&mut self, text: &str) -> &mut Self {
+        let text = text.trim();
+        if !text.is_empty() {
+            let _ = write!(self.md, "{text}\n\n");
+        }
+        self
+    }
+
+    /// A table; each row is padded or cut to the number of headers. `|` and line breaks in
+    /// cells are escaped.
+    pub fn table<H: AsRef<str>, C: AsRef<str>, R: AsRef<[C]>>(&mut self, headers: &[H], rows: &[R]) -> &mut Self {
+        if headers.is_empty() {
+            return self;
+        }
+        let line = |cells: &mut dyn Iterator<Item = String>| {
+            let mut s = String::from("|");
+            for c in cells {
+                let _ = write!(s, " {c} |");
+            }
+            s.push('\n');
+            s
+        };
+        self.md.push_str(&line(&mut headers.iter().map(|h| cell(h.as_ref()))));
+        self.md.push_str(&line(&mut headers.iter().map(|_| "---".to_owned())));
+        for r in rows {
+            let r = r.as_ref();
+            let mut cells = (0..headers.len()).map(|i| r.get(i).map(|c| cell(c.as_ref())).unwrap_or_default());
+            self.md.push_str(&line(&mut cells));
+        }
+        self.md.push('\n');
+        self
+    }
+
+    /// A figure: `rel_path` relative to the report's folder, with a caption under it.
+    pub fn image(&mut self, rel_path: &str, caption: &str) -> &mut Self {
+        let alt = one_line(caption).replace(['[', ']'], "");
+        let dest = rel_path.replace(' ', "%20");
+        let _ = write!(self.md, "![{alt}]({dest})\n\n*{}*\n\n", one_line(caption));
+        self
+    }
+
+    /// The Markdown text.
+    pub fn markdown(&self) -> &str {
+        &self.md
+    }
+
+    /// A standalone HTML page for the report in `dir`: SVG images that exist under `dir`
+    /// are inlined, other images are linked.
+    pub fn html(&self, dir: &Path) -> String {
+        let mut opts = Options::empty();
+        opts.insert(Options::ENABLE_TABLES);
+        let mut events = Vec::new();
+        let mut skip_image = false;
+        for ev in Parser::new_ext(&self.md, opts) {
+            match ev {
+                Event::Start(Tag::Image { ref dest_url, .. }) => match inline_svg(dir, dest_url) {
+                    Some(svg) => {
+                        events.push(Event::Html(CowStr::from(format!("<span class=\"figure\">{svg}</span>"))));
+                        skip_image = true;
+                    }
+                    None => events.push(ev),
+                },
+                Event::End(TagEnd::Image) if skip_image => skip_image = false,
+                _ if skip_image => {}
+                _ => events.push(ev),
+            }
+        }
+        let mut body = String::new();
+        html::push_html(&mut body, events.into_iter());
+        format!(
+            "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n<style>\n{CSS}</style>\n</head>\n<body>\n{body}</body>\n</html>\n",
+            escape_html(&self.title)
+        )
+    }
+
+    /// Write `report.md` and `index.html` into `dir` (created if missing); returns the
+    /// path of `index.html`.
+    pub fn write(&self, dir: impl AsRef<Path>) -> Result<PathBuf, ReportError> {
+        let dir = dir.as_ref();
+        std::fs::create_dir_all(dir).map_err(|source| ReportError::Io { path: dir.into(), source })?;
+        let md = dir.join("report.md");
+        std::fs::write(&md, &self.md).map_err(|source| ReportError::Io { path: md, source })?;
+        let index = dir.join("index.html");
+        std::fs::write(&index, self.html(dir)).map_err(|source| ReportError::Io { path: index.clone(), source })?;
+        Ok(index)
+    }
+}
+
+const CSS: &str = "body { font-family: sans-serif; max-width: 1040px; margin: 2em auto; padding: 0 1em; color: #222; }
+table { border-collapse: collapse; margin: 1em 0; }
+th, td { border: 1px solid #ccc; padding: 0.3em 0.7em; text-align: left; }
+th { background: #f3f3f3; }
+td { font-variant-numeric: tabular-nums; }
+img, .figure svg { max-width: 100%; height: auto; display: block; }
+code { background: #f3f3f3; padding: 0 0.2em; }
+";
+
+/// The SVG at `dir/rel` without any XML prolog, if `rel` is a relative `.svg` path that
+/// stays inside `dir` and can be read.
+fn inline_svg(dir: &Path, rel: &str) -> Option<String> {
+    let rel = rel.replace("%20", " ");
+    let p = Path::new(&rel);
+    let inside = p.is_relative() && p.components().all(|c| matches!(c, std::path::Component::Normal(_)));
+    if !inside || p.extension().is_none_or(|e| !e.eq_ignore_ascii_case("svg")) {
+        return None;
+    }
+    let text = std::fs::read_to_string(dir.join(p)).ok()?;
+    let start = text.find("<svg")?;
+    Some(text[start..].trim_end().to_owned())
+}
+
+fn one_line(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+fn cell(s: &str) -> String {
+    one_line(s).replace('|', "\\|")
+}
+
+fn escape_html(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;").replace('"', "&quot;")
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used)]
+    use super::*;
+
+    fn tmp(name: &str) -> PathBuf {
+        std::env::temp_dir().join(format!("hil-sim-report-{}-{name}", std::process::id()))
+    }
+
+    fn sample() -> Report {
+        let mut r = Report::new("Fit <report>");
+        r.heading("Held-out error")
+            .paragraph("Last 15 % of the *recording* held out.")
+            .table(&["model", "RMSE (N)", "note"], &[vec!["spencer", "196.5", "a|b"], vec!["algebraic", "250.1"]])
+            .image("loop.svg", "Force against displacement")
+            .image("missing.png", "Not there");
+        r
+    }
+
+    #[test]
+    fn markdown_has_every_block() {
+        let md = sample().markdown().to_owned();
+        assert!(md.starts_with("# Fit <report>\n\n## Held-out error\n\n"));
+        assert!(md.contains("| model | RMSE (N) | note |\n| --- | --- | --- |\n| spencer | 196.5 | a\\|b |\n"));
+        assert!(md.contains("| algebraic | 250.1 |  |\n"));
+        assert!(md.contains("![Force against displacement](loop.svg)\n\n*Force against displacement*"));
+    }
+
+    #[test]
+    fn writes_md_and_html_with_inlined_svg() {
+        let dir = tmp("out");
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("loop.svg"), "<svg width=\"10\" height=\"10\"><text>LOOPMARK</text></svg>\n").unwrap();
+        let index = sample().write(&dir).unwrap();
+        assert_eq!(index, dir.join("index.html"));
+        let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+        assert_eq!(md, sample().markdown());
+        let html = std::fs::read_to_string(&index).unwrap();
+        assert!(html.starts_with("<!DOCTYPE html>"));
+        assert!(html.contains("<title>Fit &lt;report&gt;</title>"));
+        assert!(html.contains("<h2>Held-out error</h2>"));
+        assert!(html.contains("<table>") && html.contains("<th>RMSE (N)</th>") && html.contains("<td>a|b</td>"));
+        assert!(html.contains("<em>recording</em>"));
+        assert!(html.contains("LOOPMARK"), "SVG not inlined");
+        assert!(!html.contains("src=\"loop.svg\""));
+        assert!(html.contains("<img src=\"missing.png\" alt=\"Not there\""));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn svg_outside_the_folder_is_linked_not_read() {
+        let mut r = Report::new("t");
+        r.image("../secret.svg", "up").image("/etc/x.svg", "abs");
+        let html = r.html(Path::new("/nonexistent"));
+        assert!(html.contains("<img src=\"../secret.svg\""));
+        assert!(html.contains("<img src=\"/etc/x.svg\""));
+    }
+
+    #[test]
+    fn empty_table_and_blank_paragraph_are_skipped() {
+        let mut r = Report::new("t");
+        let none: [&str; 0] = [];
+        let rows: [Vec<&str>; 0] = [];
+        r.table(&none, &rows).paragraph("   ");
+        assert_eq!(r.markdown(), "# t\n\n");
+        assert_eq!(r.title(), "t");
+    }
+}
+
+pub mod fit;
+pub mod plot;
