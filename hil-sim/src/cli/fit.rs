@@ -3,7 +3,6 @@ use std::time::Instant;
 
 use anyhow::{bail, Context};
 use clap::Args;
-use hil_sim::ident::fit::spec::FITTABLE;
 use hil_sim::ident::fit::{fit, Dataset, DelayChoice, FitOptions, FitResult};
 use hil_sim::io::params_file::ParamsFile;
 use hil_sim::io::recording::Recording;
@@ -65,15 +64,12 @@ pub fn parse_delay(s: &str) -> Result<DelayChoice, String> {
 /// The models `--model` names.
 pub fn model_list(arg: &str) -> anyhow::Result<Vec<String>> {
     if arg == "all" {
-        return Ok(FITTABLE.iter().map(|s| (*s).to_owned()).collect());
+        return Ok(model_core::MODELS.iter().map(|m| m.id.to_owned()).collect());
     }
     let list: Vec<String> = arg.split(',').map(|s| s.trim().to_owned()).filter(|s| !s.is_empty()).collect();
     for id in &list {
         if model_core::registry::find(id).is_none() {
             bail!("--model {id}: unknown model (see `hil-sim models`)");
-        }
-        if !FITTABLE.contains(&id.as_str()) {
-            bail!("--model {id}: not fitted by this build (fittable: {})", FITTABLE.join(", "));
         }
     }
     if list.is_empty() {

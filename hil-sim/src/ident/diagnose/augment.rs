@@ -20,8 +20,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::ident::fit::simulate::{kinematics, Simulator};
-use crate::ident::fit::spec::{ModelSpec, Spacing};
 use crate::ident::fit::Dataset;
+use crate::models::search::{ModelSpec, Spacing};
 use crate::models::RateChoice;
 
 /// A change to what the base model is fed.
@@ -344,7 +344,7 @@ impl Problem<'_> {
         let mut start = theta.to_vec();
         if let Some(t) = tune {
             let (lo, hi) = (t.lo.min(t.hi), t.hi.max(t.lo));
-            spec.params.push(crate::ident::fit::spec::ParamSpec {
+            spec.params.push(crate::models::search::ParamSpec {
                 name: "candidate",
                 lo,
                 hi,

@@ -269,13 +269,14 @@ pub fn diagnose(
     let dt = data.dt;
     let sim = crate::ident::fit::simulate::simulator(&id, dt as f32)
         .ok_or_else(|| DiagnoseError::NotParametric(id.clone()))?;
-    let spec = crate::ident::fit::spec::spec(&id, &data.scales(), Some(base.rate_choice))
+    let spec = crate::models::host(&id)
+        .and_then(|h| h.spec(&data.scales(), Some(base.rate_choice)))
         .ok_or_else(|| DiagnoseError::NotParametric(id.clone()))?;
     if !matches!(
         spec.strategy,
-        crate::ident::fit::spec::Strategy::Linear
-            | crate::ident::fit::spec::Strategy::Local
-            | crate::ident::fit::spec::Strategy::Global
+        crate::models::search::Strategy::Linear
+            | crate::models::search::Strategy::Local
+            | crate::models::search::Strategy::Global
     ) {
         return Err(DiagnoseError::NotParametric(id));
     }

@@ -1,6 +1,6 @@
-//! Closed-form least squares for the models that are linear in their parameters: the
-//! algebraic model (seed 000 eq. 14) and the Bingham model with its command polynomials
-//! (seed 003 eq. 12–14).
+//! Closed-form least squares for the models that are linear in their parameters (today the
+//! algebraic model, seed 000 eq. 14, and the Bingham model with its command polynomials,
+//! seed 003 eq. 12–14; each declares its regressors in its host file).
 //!
 //! The regressors are evaluated on the same f32 kinematics the core sees; a unit test
 //! checks them against the core's own output so the two cannot drift apart.
@@ -8,42 +8,12 @@
 use model_core::Kin;
 use nalgebra::{DMatrix, DVector};
 
-/// Most regressors any linear model has.
-const MAX_REGRESSORS: usize = 10;
+use crate::models::MAX_REGRESSORS;
 
-/// Regressor row of model `id` at one sample (`None` for a model that is not linear).
+/// Regressor row of model `id` at one sample (`None` for a model that is not linear);
+/// each model writes its own in its host file ([`crate::models::HostModel::regressors`]).
 pub fn regressors(id: &str, k: &Kin) -> Option<Vec<f64>> {
-    let mut row = [0.0; MAX_REGRESSORS];
-    let n = regressors_into(id, k, &mut row)?;
-    Some(row.get(..n)?.to_vec())
-}
-
-/// Write the regressor row of `id` at `k` into `row`; returns how many there are.
-fn regressors_into(id: &str, k: &Kin, row: &mut [f64; MAX_REGRESSORS]) -> Option<usize> {
-    let (x, dx, u) = (f64::from(k.x), f64::from(k.dx), f64::from(k.u));
-    let sgn = |v: f64| {
-        if v > 0.0 {
-            1.0
-        } else if v < 0.0 {
-            -1.0
-        } else {
-            0.0
-        }
-    };
-    match id {
-        // T = k·B + c·Ḃ + α·|B|·B³ + T₀
-        "algebraic" => {
-            row[..4].copy_from_slice(&[x, dx, x.abs() * x.powi(3), 1.0]);
-            Some(4)
-        }
-        // F = (fc0 + fc1·u + fc2·u² + fc3·u³)·sgn(ẋ) + (c0_0 + … + c0_4·u⁴)·ẋ + f0
-        "bingham" => {
-            let s = sgn(dx);
-            *row = [s, s * u, s * u * u, s * u.powi(3), dx, dx * u, dx * u * u, dx * u.powi(3), dx * u.powi(4), 1.0];
-            Some(10)
-        }
-        _ => None,
-    }
+    crate::models::host(id)?.regressors(k)
 }
 
 /// Least-squares solution over the rows `rows` of the free columns `free`; fixed
@@ -55,6 +25,7 @@ fn regressors_into(id: &str, k: &Kin, row: &mut [f64; MAX_REGRESSORS]) -> Option
 /// does not excite gets a zero coefficient instead of a blow-up. `None` for a model that is
 /// not linear.
 pub fn solve(id: &str, kin: &[Kin], y: &[f64], rows: &[usize], free: &[usize], p: &[f64]) -> Option<Vec<f64>> {
+    let host = crate::models::host(id)?;
     let n = free.len();
     let mut gram = DMatrix::<f64>::zeros(n, n);
     let mut atb = DVector::<f64>::zeros(n);
@@ -65,7 +36,7 @@ pub fn solve(id: &str, kin: &[Kin], y: &[f64], rows: &[usize], free: &[usize], p
     }
     let mut a = [0.0; MAX_REGRESSORS];
     for &i in rows {
-        let len = regressors_into(id, kin.get(i)?, &mut phi)?;
+        let len = host.regressors_into(kin.get(i)?, &mut phi)?;
         let fixed: f64 = (0..len).filter(|&j| !is_free[j]).map(|j| phi[j] * p.get(j).copied().unwrap_or(0.0)).sum();
         let b = y.get(i)? - fixed;
         for (c, &j) in free.iter().enumerate() {

@@ -146,7 +146,7 @@ pub fn minimize(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> Lo
 mod tests {
     use super::*;
     use crate::ident::fit::simulate::{kinematics, simulator};
-    use crate::ident::fit::spec::{spec, Scales};
+    use crate::models::search::Scales;
     use crate::models::RateChoice;
     use model_core::Sample;
 
@@ -166,7 +166,7 @@ mod tests {
         let mut y = vec![0.0; kin.len()];
         assert!(sim.run(&truth, &kin, &mut y));
         let sc = Scales { x_mean: 0.0, x: 0.8, dx: 1.5, ddx: 4.0, y_mean: 0.0, y: 2.0, u: None, fs: 1000.0 };
-        let sp = spec("bouc_wen", &sc, Some(RateChoice::Backward)).unwrap();
+        let sp = crate::models::host("bouc_wen").unwrap().spec(&sc, Some(RateChoice::Backward)).unwrap();
         let rows: Vec<usize> = (0..kin.len()).collect();
         let obj = Objective::new(sim.as_ref(), &sp, &kin, &y, &rows, 2.0);
         let start = [2.0, 1.0, 2.0, 1.0, 1.5, 0.2, 0.5, 0.1];

@@ -22,7 +22,6 @@ pub mod narx_net;
 pub mod objective;
 pub mod operator;
 pub mod simulate;
-pub mod spec;
 
 use std::time::Instant;
 
@@ -34,11 +33,11 @@ use thiserror::Error;
 use crate::io::params_file::{ParamsFile, Values};
 use crate::io::recording::{Recording, RecordingError};
 use crate::models::replay::{gradient, Channels};
+use crate::models::search::{ModelSpec, Scales, Strategy, Structure};
 use crate::models::{replay, RateChoice};
 use crate::numerics::metrics::{metrics, Metrics};
 use global::SwarmOptions;
 use objective::Objective;
-use spec::{ModelSpec, Scales, Strategy};
 
 /// Why a fit could not run.
 #[derive(Debug, Error)]
@@ -53,7 +52,7 @@ pub enum FitError {
     NoHeldOut,
     #[error("unknown model `{0}` (see `hil-sim models`)")]
     UnknownModel(String),
-    #[error("model `{0}` is not fitted by this build (fittable: {list})", list = spec::FITTABLE.join(", "))]
+    #[error("model `{0}` is not fitted by this build")]
     NotFittable(String),
     #[error("{model}: the rate estimate overflows on this input")]
     RateOverflow { model: String },
@@ -266,7 +265,8 @@ pub fn rate_name(r: RateChoice) -> String {
 pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, FitError> {
     let info = model_core::registry::find(id).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
     let scales = data.scales();
-    let sp = spec::spec(id, &scales, opts.rate).ok_or_else(|| FitError::NotFittable(id.to_owned()))?;
+    let host = crate::models::host(id).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
+    let sp = host.spec(&scales, opts.rate).ok_or_else(|| FitError::NotFittable(id.to_owned()))?;
     let started = Instant::now();
     let dt = data.dt as f32;
     let samples = data.samples();
@@ -297,7 +297,10 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
             (found.0, (found.1, 0.0))
         }
         (DelayChoice::Auto, _) => {
-            let spd = sp.clone().with_delays(data.command.is_some() && uses_command(id, &scales));
+            let spd = sp.clone().with_delays(
+                data.command.is_some() && uses_command(id, &scales),
+                crate::ident::alignment::MAX_DELAY_SAMPLES,
+            );
             let (p, e) = fit_at(&kin, &spd)?;
             let d = (p.get(n_model).copied().unwrap_or(0.0), p.get(n_model + 1).copied().unwrap_or(0.0));
             ((p, e), d)
@@ -306,7 +309,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     params.truncate(n_model);
     let fit_seconds = started.elapsed().as_secs_f64();
     let mut warnings = Vec::new();
-    if id == "bouc_wen_asym" {
+    if sp.structure == Structure::AsymmetricBoucWen {
         let mut shifted = Vec::new();
         crate::ident::alignment::shift_kin(&kin, delay, delay_u, &mut shifted);
         if operator::abw_crossing(&params, dt, &shifted, &rows) == Some(true) {
@@ -364,7 +367,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         evaluations,
         replay_ns_per_sample: replay_ns,
         n_params: info.n_params,
-        free_params: sp.free().len() + operator::projected_count(id),
+        free_params: sp.free().len() + operator::projected_count(sp.structure),
         state_bytes: info.state_bytes,
         held: rep.held,
         warnings,
@@ -377,11 +380,11 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
 /// Whether model `id` has a command-dependent parameter the fit frees (its spec fixes more
 /// parameters when the recording has no command channel).
 fn uses_command(id: &str, scales: &Scales) -> bool {
-    let free = |s: &Scales| spec::spec(id, s, None).map_or(0, |sp| sp.free().len());
+    let free = |s: &Scales| crate::models::host(id).and_then(|h| h.spec(s, None)).map_or(0, |sp| sp.free().len());
     free(&Scales { u: None, ..*scales }) < free(scales)
 }
 
-/// [`identify`] for every variant of the search ([`spec::variant`]); the lowest training
+/// [`identify`] for every variant of the search ([`crate::models::HostModel::variant`]); the lowest training
 /// cost wins.
 #[allow(clippy::too_many_arguments)]
 fn identify_variants(
@@ -411,7 +414,7 @@ fn identify_variants(
             Err(e) => first_err = first_err.or(Some(e)),
         }
         k += 1;
-        current = spec::variant(sp, k, scales);
+        current = crate::models::host(sp.id).and_then(|h| h.variant(sp, k, scales));
     }
     match (best, first_err) {
         (Some((p, _, _)), _) => Ok((p, evals)),
@@ -451,7 +454,7 @@ fn identify(
         }
         Strategy::Operator => {
             let n_ops = (sim.n_params().saturating_sub(2)) / 2;
-            let (mut p, _) = operator::closed_form(id, n_ops, kin, y, rows)
+            let (mut p, _) = operator::closed_form(sp.structure, n_ops, kin, y, rows)
                 .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
             // Delay entries, if the spec carries them, stay at their (zero) start.
             p.extend(sp.start().get(sim.n_params()..).unwrap_or(&[]).iter().copied());
@@ -481,7 +484,7 @@ fn identify(
             // per weight per Jacobian) to a few seconds on the Dyke files; NARX has its own
             // ([`narx_net::Effort`]).
             let (iterations, window) = (3 * opts.lm_iterations.max(1), opts.swarm_window.min(6000));
-            let t = narx::train(id, kin, y, rows, 1e-3, sp.rate, iterations, window, opts.swarm.seed)
+            let t = narx::train(sp.structure, kin, y, rows, 1e-3, sp.rate, iterations, window, opts.swarm.seed)
                 .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
             valid_or_err(id, sim, t.params, t.evaluations)
         }

@@ -21,7 +21,7 @@ use rand::{Rng, SeedableRng};
 use super::lm;
 use super::objective::Objective;
 use super::simulate::simulator_of;
-use super::spec::{ModelSpec, ParamSpec, Spacing, Strategy};
+use crate::models::search::{ModelSpec, ParamSpec, Spacing, Strategy, Structure};
 use crate::models::RateChoice;
 
 /// Hidden units of the Hammerstein–Wiener networks that are trained (input, output side).
@@ -69,7 +69,7 @@ fn subsample(rows: &[usize]) -> Vec<usize> {
 /// one pass, not one per weight). `None` for another model or when no valid network was found.
 #[allow(clippy::too_many_arguments)]
 pub fn train(
-    id: &str,
+    structure: Structure,
     kin: &[Kin],
     y: &[f64],
     rows: &[usize],
@@ -87,9 +87,9 @@ pub fn train(
     let (xlo, xhi) = xs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
     let mut rng = StdRng::seed_from_u64(seed);
     let sub = subsample(rows);
-    let (spec, sim) = match id {
-        "narx" => return train_narx(kin, y, rows, dt, (xm, xsd), (ym, ysd), (ylo, yhi), seed),
-        "hammerstein_wiener" => {
+    let (spec, sim) = match structure {
+        Structure::Narx => return train_narx(kin, y, rows, dt, (xm, xsd), (ym, ysd), (ylo, yhi), seed),
+        Structure::HammersteinWiener => {
             let (nh, nw) = HW_TRAINED;
             // Output net's line: y ≈ w_lin·x + w_d.
             let slope = {
@@ -134,7 +134,7 @@ pub fn train(
         }
         _ => return None,
     };
-    let sp = ModelSpec { id: super::spec::static_id(id)?, params: spec, strategy: Strategy::Network, rate };
+    let sp = ModelSpec { id: sim.id(), params: spec, strategy: Strategy::Network, structure: Structure::Generic, rate };
     let start = sp.start();
     let win_rows: Vec<usize> = rows.iter().copied().filter(|&i| i < window).collect();
     let win_rows = if win_rows.len() < 200 { sub.clone() } else { subsample(&win_rows) };
@@ -153,7 +153,7 @@ pub fn train(
     let whole = Objective::new(sim.as_ref(), &sp, kin, y, &sub, ysd);
     let (trained_cost, start_cost) = (whole.cost(&b.params), whole.cost(&start));
     let (best, cost) = if trained_cost <= start_cost { (b.params, trained_cost) } else { (start, start_cost) };
-    let params = if id == "hammerstein_wiener" { embed_hw(&best)? } else { best };
+    let params = if structure == Structure::HammersteinWiener { embed_hw(&best)? } else { best };
     Some(Trained { params, evaluations: a.evaluations + b.evaluations + 1, cost })
 }
 

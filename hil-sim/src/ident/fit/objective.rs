@@ -6,8 +6,8 @@ use std::sync::{Arc, Mutex};
 use model_core::Kin;
 
 use super::simulate::Simulator;
-use super::spec::ModelSpec;
 use crate::ident::alignment::{shift_kin, MAX_DELAY_SAMPLES};
+use crate::models::search::ModelSpec;
 
 /// Kinematics shifted by an (input, command) delay pair, in samples.
 type ShiftedKin = ((f64, f64), Arc<Vec<Kin>>);

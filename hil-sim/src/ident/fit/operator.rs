@@ -17,6 +17,7 @@ use model_core::models::prandtl_ishlinskii::play;
 use model_core::Kin;
 
 use super::simulate::Simulator;
+use crate::models::search::Structure;
 use crate::numerics::nnls;
 
 /// Smallest and largest input over the first `end` samples.
@@ -74,7 +75,13 @@ fn slip_column(kin: &[Kin], lim: f32) -> Vec<f64> {
 /// Closed-form fit of `prandtl_ishlinskii` (`N` = `n_ops`) or `maxwell_slip` on the
 /// training rows: the flat parameter vector and its training cost (mean squared residual,
 /// output units). `None` for another model or data the solver cannot use.
-pub fn closed_form(id: &str, n_ops: usize, kin: &[Kin], y: &[f64], rows: &[usize]) -> Option<(Vec<f64>, f64)> {
+pub fn closed_form(
+    structure: Structure,
+    n_ops: usize,
+    kin: &[Kin],
+    y: &[f64],
+    rows: &[usize],
+) -> Option<(Vec<f64>, f64)> {
     let end = rows.last().map_or(0, |r| r + 1).min(kin.len());
     let kin = kin.get(..end)?;
     let (lo, hi) = x_range(kin, end);
@@ -85,8 +92,8 @@ pub fn closed_form(id: &str, n_ops: usize, kin: &[Kin], y: &[f64], rows: &[usize
             best = Some((p, c));
         }
     };
-    match id {
-        "prandtl_ishlinskii" if n_ops >= 2 => {
+    match structure {
+        Structure::PlayOperators if n_ops >= 2 => {
             // Operators 1…N−1 with radii up to the spread; operator N with a radius beyond
             // the input range never moves from M₀ and carries the output offset (its weight
             // times M₀), so M₀ takes the sign of the offset.
@@ -123,7 +130,7 @@ pub fn closed_form(id: &str, n_ops: usize, kin: &[Kin], y: &[f64], rows: &[usize
                 }
             }
         }
-        "maxwell_slip" if n_ops >= 1 => {
+        Structure::ElastoSlide if n_ops >= 1 => {
             for spread in SPREADS {
                 let lims: Vec<f64> = (1..=n_ops).map(|i| spread * 0.5 * span * i as f64 / n_ops as f64).collect();
                 let mut cols: Vec<Vec<f64>> = lims.iter().map(|l| slip_column(kin, *l as f32)).collect();
@@ -171,10 +178,10 @@ pub struct Projected<'a> {
 }
 
 /// Number of parameters [`Projected`] solves in closed form for model `id` (0: not projected).
-pub fn projected_count(id: &str) -> usize {
-    match id {
-        "preisach" => 2,
-        "gpi" => 3,
+pub fn projected_count(structure: Structure) -> usize {
+    match structure {
+        Structure::PreisachProjection => 2,
+        Structure::GpiProjection => 3,
         _ => 0,
     }
 }
@@ -182,9 +189,9 @@ pub fn projected_count(id: &str) -> usize {
 impl<'a> Projected<'a> {
     /// `None` for a model without a projection.
     pub fn new(inner: &'a dyn Simulator, y: &'a [f64], rows: &'a [usize]) -> Option<Self> {
-        let kind = match inner.id() {
-            "preisach" => Linear::Preisach,
-            "gpi" => Linear::Gpi,
+        let kind = match crate::models::host(inner.id())?.structure {
+            Structure::PreisachProjection => Linear::Preisach,
+            Structure::GpiProjection => Linear::Gpi,
             _ => return None,
         };
         Some(Self { inner, kind, y, rows })
@@ -367,6 +374,7 @@ mod tests {
         let rows: Vec<usize> = (0..kin.len()).collect();
         for id in ["maxwell_slip", "prandtl_ishlinskii"] {
             let sim = simulator(id, 1e-3).unwrap();
+            let structure = crate::models::host(id).unwrap().structure;
             let truth: Vec<f64> = if id == "maxwell_slip" {
                 // kᵢ > 0 in the core: the unused elements get a negligible stiffness.
                 let k = [2.0, 1e-6, 1.0, 1e-6, 1e-6, 3.0, 1e-6, 1e-6, 1e-6, 1e-6];
@@ -383,13 +391,13 @@ mod tests {
             };
             let mut y = vec![0.0; kin.len()];
             assert!(sim.run(&truth, &kin, &mut y), "{id}");
-            let (p, cost) = closed_form(id, 10, &kin, &y, &rows).unwrap();
+            let (p, cost) = closed_form(structure, 10, &kin, &y, &rows).unwrap();
             let mut out = vec![0.0; kin.len()];
             assert!(sim.run(&p, &kin, &mut out), "{id}: {p:?}");
             let var = y.iter().map(|v| v * v).sum::<f64>() / y.len() as f64;
             let mse = y.iter().zip(&out).map(|(a, b)| (a - b) * (a - b)).sum::<f64>() / y.len() as f64;
             assert!(mse < 1e-3 * var && cost < 1e-3 * var, "{id}: mse {mse}, cost {cost}, var {var}");
         }
-        assert!(closed_form("bouc_wen", 10, &kin, &[0.0; 10], &rows).is_none());
+        assert!(closed_form(Structure::Generic, 10, &kin, &[0.0; 10], &rows).is_none());
     }
 }

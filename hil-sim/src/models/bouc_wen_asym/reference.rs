@@ -10,7 +10,7 @@
 //! Parameters in model-core's `bouc_wen_asym` order:
 //! `alpha, kappa, d, a, beta, gamma, n, z0, delta, p, q, variant`.
 
-use super::{Case, Command, Input, InputScale, Reference};
+use crate::models::reference::{Case, Command, Input, InputScale, Reference};
 
 /// Continuous-time ABW with f64 parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,13 +1,7 @@
-//! f64 continuous-time right-hand sides of the ODE models, written from the papers
-//! independently of model-core's discretisations. The accuracy check
+//! The f64 reference of an ODE model: its continuous-time right-hand side, written from the
+//! papers (in `models/<id>/reference.rs`) independently of model-core's discretisations. The accuracy check
 //! (`hil-sim accuracy`) integrates them with a fine adaptive step and compares the f32
 //! one-step-per-sample core against them.
-
-pub mod bouc_wen;
-pub mod bouc_wen_asym;
-pub mod dahl;
-pub mod lugre;
-pub mod spencer;
 
 /// The input at one instant: value, first and second time derivatives, command.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -64,13 +58,7 @@ pub struct Case {
     pub on_dyke_recording: bool,
 }
 
-/// Every case of every ODE model.
+/// Every case of every ODE model, in the registry's order.
 pub fn cases() -> Vec<Case> {
-    let mut all = Vec::new();
-    all.extend(bouc_wen::cases());
-    all.extend(lugre::cases());
-    all.extend(spencer::cases());
-    all.extend(dahl::cases());
-    all.extend(bouc_wen_asym::cases());
-    all
+    super::HOSTS.iter().flat_map(|h| h.reference_cases()).collect()
 }

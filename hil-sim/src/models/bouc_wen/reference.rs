@@ -18,7 +18,7 @@
 //!   I = 0.75 A (α = 173.267 N/mm, c₀ = 8.907 N·s/mm), and the accumulator force f₀ = 40 N
 //!   as `x₀ = −f₀/k₀`; 4 mm amplitude as in its tests.
 
-use super::{Case, Command, Input, InputScale, Reference};
+use crate::models::reference::{Case, Command, Input, InputScale, Reference};
 
 /// Continuous-time Bouc–Wen in f64.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -122,7 +122,7 @@ pub fn cases() -> Vec<Case> {
 /// RK4 and step the f32 model once per sample with the analytic rate.
 #[cfg(test)]
 pub(crate) mod check {
-    use super::super::{Case, Input, Reference};
+    use crate::models::reference::{Case, Input, Reference};
     use model_core::{Kin, Model};
 
     /// Unit excitation u(t) with its first two derivatives.

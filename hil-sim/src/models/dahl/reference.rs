@@ -11,7 +11,7 @@
 //! A negative command is 0 V (unipolar driver, as in model-core's `dahl`). Initial state:
 //! `z = 0`, `u = max(V, 0)` at the first instant.
 
-use super::{Case, Command, Input, InputScale, Reference};
+use crate::models::reference::{Case, Command, Input, InputScale, Reference};
 
 /// The 8 parameters in model-core's order: C0s, C0d, Fds, Fdu, K0, sigma, f0, eta.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -105,8 +105,8 @@ pub fn cases() -> Vec<Case> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::spencer::tests::{integrate, pwl, r_rmse, read_dyke, run_core};
     use super::*;
+    use crate::models::spencer::reference::tests::{integrate, pwl, r_rmse, read_dyke, run_core};
     use model_core::models::dahl::Dahl as Core;
     use model_core::Model;
 

@@ -7,7 +7,7 @@
 //! Cases: seed 000 Table 4, the five per-frequency sets and the average, with B mapped to
 //! 0…3 (amplitude 1.5, offset 1.5).
 
-use super::{Case, Command, Input, InputScale, Reference};
+use crate::models::reference::{Case, Command, Input, InputScale, Reference};
 
 /// Continuous-time LuGre in f64.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -86,7 +86,7 @@ pub fn cases() -> Vec<Case> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::models::reference::bouc_wen::check;
+    use crate::models::bouc_wen::reference::check;
     use model_core::models::lugre::LuGre;
     use model_core::Model;
 

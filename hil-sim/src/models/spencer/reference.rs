@@ -14,7 +14,7 @@
 //! same model definition as model-core's `spencer`). Initial state: `y = x`, `z = 0`,
 //! `u = max(v, 0)` at the first instant (at rest, filter settled).
 
-use super::{Case, Command, Input, InputScale, Reference};
+use crate::models::reference::{Case, Command, Input, InputScale, Reference};
 
 /// The 14 parameters in model-core's `PARAM_NAMES` order:
 /// c0a, c0b, k0, c1a, c1b, k1, x0, alpha_a, alpha_b, gamma, beta, A, n, eta.
