@@ -7,7 +7,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use hil_sim::ident::fit::{fit, Dataset, DelayChoice, FitOptions};
 use hil_sim::io::recording::Recording;
 use hil_sim::models::replay::Channels;
-use hil_sim::models::{replay, RateChoice};
+use hil_sim::models::{replay, RateSpec};
 use model_core::Sample;
 
 fn dyke(train: f64, take: Option<usize>) -> Dataset {
@@ -53,9 +53,7 @@ fn bench(c: &mut Criterion) {
         // Spencer et al. (1997) for this damper; the command channel Y drives it.
         ("spencer", vec![21.0, 3.5, 46.9, 283.0, 2.95, 5.0, 14.3, 140.0, 695.0, 363.0, 363.0, 301.0, 2.0, 190.0]),
     ] {
-        g.bench_function(id, |b| {
-            b.iter(|| replay(id, &p, d.dt as f32, RateChoice::Backward, &samples).expect("replay"))
-        });
+        g.bench_function(id, |b| b.iter(|| replay(id, &p, d.dt as f32, RateSpec::Backward, &samples).expect("replay")));
     }
     g.finish();
 }

@@ -7,7 +7,7 @@ use hil_sim::ident::fit::{Dataset, FitOptions, FitResult};
 use hil_sim::io::params_file::ParamsFile;
 use hil_sim::io::recording::Recording;
 use hil_sim::models::replay::{replay_recording, Channels};
-use hil_sim::models::RateChoice;
+use hil_sim::models::RateSpec;
 use hil_sim::quality;
 use hil_sim::report::fit::{error_bars, fit_plots, results_table, Labels};
 use hil_sim::report::plot::{self, Series, Style};
@@ -139,7 +139,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     let mut rows = Vec::new();
     let mut replays = Vec::new();
     for f in &fits {
-        let r = replay_recording(&f.rec, &dyke_channels(), &pf.model, &flat, RateChoice::Backward, (0.0, 0.0))?;
+        let r = replay_recording(&f.rec, &dyke_channels(), &pf.model, &flat, RateSpec::Backward, (0.0, 0.0))?;
         let m = r.metrics;
         rows.push(vec![
             f.file.to_owned(),

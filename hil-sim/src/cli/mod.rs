@@ -18,7 +18,7 @@ use std::path::PathBuf;
 use anyhow::bail;
 use clap::{Args, Parser, Subcommand};
 use hil_sim::models::replay::Channels;
-use hil_sim::models::RateChoice;
+use hil_sim::models::RateSpec;
 
 #[derive(Parser, Debug)]
 #[command(name = "hil-sim", version, about = "Host tooling for the MR clutch torque controller")]
@@ -104,7 +104,7 @@ impl ChannelArgs {
         }
     }
     /// The rate estimator named by `--rate`; `None` for `auto`.
-    pub fn rate(&self) -> anyhow::Result<Option<RateChoice>> {
+    pub fn rate(&self) -> anyhow::Result<Option<RateSpec>> {
         if self.rate == "auto" {
             Ok(None)
         } else {
@@ -113,8 +113,8 @@ impl ChannelArgs {
     }
 }
 
-pub fn parse_rate(s: &str) -> anyhow::Result<RateChoice> {
-    RateChoice::parse(s).map_err(anyhow::Error::msg)
+pub fn parse_rate(s: &str) -> anyhow::Result<RateSpec> {
+    hil_sim::models::rate::parse(s).map_err(|e| anyhow::anyhow!("--rate {e}"))
 }
 
 /// Print one JSON object on stdout.

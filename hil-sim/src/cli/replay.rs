@@ -31,7 +31,7 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
     let rate = match (a.ch.rate()?, pf.rate.as_deref()) {
         (Some(r), _) => r,
         (None, Some(r)) => super::parse_rate(r).with_context(|| format!("{}: `rate`", a.params.display()))?,
-        (None, None) => hil_sim::models::RateChoice::Backward,
+        (None, None) => hil_sim::models::RateSpec::Backward,
     };
     let flat = pf.flat(&a.params)?;
     let rec = Recording::read(&super::file_arg(&a.rec)?)?;

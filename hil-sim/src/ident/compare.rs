@@ -47,7 +47,7 @@ pub struct Averaged {
     #[serde(skip)]
     pub flat: Vec<f64>,
     #[serde(skip)]
-    pub rate: crate::models::RateChoice,
+    pub rate: crate::models::RateSpec,
 }
 
 /// Table 7: one averaged model on one validation recording (whole recording).
@@ -212,7 +212,7 @@ mod tests {
     use crate::ident::fit::simulate::{kinematics, simulator};
     use crate::io::recording::{Column, Recording};
     use crate::models::replay::Channels;
-    use crate::models::RateChoice;
+    use crate::models::RateSpec;
     use crate::sim::excitation::Excitation;
     use std::path::Path;
 
@@ -224,7 +224,7 @@ mod tests {
         let t: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
         let x: Vec<f64> = t.iter().map(|t| s.at(*t).x).collect();
         let samples: Vec<model_core::Sample> = x.iter().map(|v| model_core::Sample::new(*v as f32)).collect();
-        let kin = kinematics(&samples, dt as f32, RateChoice::Backward).unwrap();
+        let kin = kinematics(&samples, dt as f32, RateSpec::Backward).unwrap();
         let mut y = vec![0.0; n];
         assert!(simulator("bouc_wen", dt as f32).unwrap().run(truth, &kin, &mut y));
         let rec = Recording::from_columns(
@@ -250,7 +250,7 @@ mod tests {
         // The truth was generated with backward differences: fit with the same estimator, and
         // let the solver converge on noiseless data.
         let opts = FitOptions {
-            rate: Some(RateChoice::Backward),
+            rate: Some(RateSpec::Backward),
             lm_iterations: 30,
             polish_iterations: 30,
             ..FitOptions::default()

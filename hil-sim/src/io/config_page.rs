@@ -8,7 +8,7 @@ use model_core::control::{ConfigImage, ControlConfig, ValidatedConfig};
 use model_core::Model;
 
 use crate::io::params_file::ParamsFile;
-use crate::models::{visit, RateChoice, Visit};
+use crate::models::{visit, RateSpec, Visit};
 
 /// The firmware's default control rate, Hz.
 pub const CONTROL_HZ: f32 = 20_000.0;
@@ -35,11 +35,11 @@ pub fn image(file: &ParamsFile, path: &Path, control: ValidatedConfig) -> anyhow
         .with_context(|| format!("{}: unknown model `{}`", path.display(), file.model))?
         .with_context(|| format!("{}: {} parameters rejected at dt = {dt} s", path.display(), file.model))?;
     let rate = match &file.rate {
-        Some(r) => RateChoice::parse(r).map_err(anyhow::Error::msg)?,
-        None => RateChoice::Backward,
+        Some(r) => crate::models::rate::parse(r).map_err(anyhow::Error::msg)?,
+        None => RateSpec::Backward,
     };
     rate.build(dt).with_context(|| format!("{}: rate estimator `{rate:?}` at dt = {dt} s", path.display()))?;
-    ConfigImage::new(&file.model, &flat, rate.spec(), control).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+    ConfigImage::new(&file.model, &flat, rate, control).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
 /// Control settings at `control_hz` from the defaults (`ControlConfig::defaults`).

@@ -20,7 +20,7 @@ use serde::Serialize;
 
 use crate::io::recording::Recording;
 use crate::models::reference::{Case, Command, Input, Reference};
-use crate::models::{replay, RateChoice};
+use crate::models::{replay, RateSpec};
 use crate::sim::excitation::Excitation;
 
 /// The acceptance bound on the R-RMSE of the difference.
@@ -195,8 +195,7 @@ pub fn synthetic(case: &Case, exc: &Excitation, fs: f64, duration: f64) -> Resul
             }
         })
         .collect();
-    let core =
-        replay(case.model, &case.params, dt as f32, RateChoice::Backward, &samples).map_err(|e| e.to_string())?;
+    let core = replay(case.model, &case.params, dt as f32, RateSpec::Backward, &samples).map_err(|e| e.to_string())?;
     let r = dense_outputs(case.reference.as_ref(), n, dt, input_at)?;
     Ok(compare(case, exc.name(), fs, &core.y, core.held, &r))
 }
@@ -209,8 +208,7 @@ pub fn dyke(case: &Case, rec: &Recording) -> Result<Row, String> {
     let dt = rec.mean_dt("t").map_err(|e| e.to_string())?;
     let n = x.len();
     let samples: Vec<Sample> = x.iter().zip(u).map(|(x, u)| Sample::new(*x as f32).with_command(*u as f32)).collect();
-    let core =
-        replay(case.model, &case.params, dt as f32, RateChoice::Backward, &samples).map_err(|e| e.to_string())?;
+    let core = replay(case.model, &case.params, dt as f32, RateSpec::Backward, &samples).map_err(|e| e.to_string())?;
     // The f32 core sees x and u in f32: give the reference the same rounded values.
     let xf: Vec<f64> = x.iter().map(|v| f64::from(*v as f32)).collect();
     let uf: Vec<f64> = u.iter().map(|v| f64::from(*v as f32)).collect();

@@ -1,10 +1,13 @@
-//! Replay a recording through the no_std core in f32, one step per sample.
+//! Replay through the no_std core in f32, one step per sample: any model by id over
+//! samples ([`replay()`]), and a recording's channels with the error metrics
+//! ([`replay_recording`]).
 
-use model_core::Sample;
+use model_core::{Estimator, Model, ParamError, Sample};
 use serde::Serialize;
+use thiserror::Error;
 
 use crate::io::recording::Recording;
-use crate::models::{replay, RateChoice};
+use crate::models::{visit, RateSpec, Visit};
 use crate::numerics::metrics::{metrics, Metrics};
 
 /// Which columns play which role.
@@ -48,7 +51,7 @@ pub fn replay_recording(
     ch: &Channels,
     model: &str,
     params: &[f32],
-    rate: RateChoice,
+    rate: RateSpec,
     delays_s: (f64, f64),
 ) -> anyhow::Result<ReplayReport> {
     let t = rec.time(&ch.time)?;
@@ -62,8 +65,8 @@ pub fn replay_recording(
     let out = replay(model, params, dt as f32, rate, &samples)?;
     let model_output: Vec<f64> = out.y.iter().map(|v| f64::from(*v)).collect();
     // Rates for seed 001's E_x, E_ẋ: central differences of the input.
-    let dx = gradient(&x, dt);
-    let ddx = gradient(&dx, dt);
+    let dx = crate::numerics::derivative::gradient(&x, dt);
+    let ddx = crate::numerics::derivative::gradient(&dx, dt);
     // Samples whose shifted channels read past the recording's ends are not scored.
     let (lo, hi) = crate::ident::alignment::covered(x.len(), &[d, d_u]);
     let part = |v: &[f64]| v.get(lo..hi).unwrap_or(&[]).to_vec();
@@ -106,15 +109,80 @@ pub fn samples(x: &[f64], u: Option<&[f64]>) -> Vec<Sample> {
         .collect()
 }
 
-/// Central-difference derivative (one-sided at the ends).
-pub fn gradient(v: &[f64], dt: f64) -> Vec<f64> {
-    let n = v.len();
-    (0..n)
-        .map(|i| match (i.checked_sub(1).and_then(|j| v.get(j)), v.get(i + 1)) {
-            (Some(a), Some(b)) => (b - a) / (2.0 * dt),
-            (None, Some(b)) => (b - v[i]) / dt,
-            (Some(a), None) => (v[i] - a) / dt,
-            (None, None) => 0.0,
-        })
-        .collect()
+/// Why a replay could not start.
+#[derive(Debug, Error)]
+pub enum ReplayError {
+    #[error("unknown model `{0}` (see `hil-sim models`)")]
+    UnknownModel(String),
+    #[error("model `{model}`: {source}")]
+    Params { model: String, source: ParamError },
+}
+
+/// Result of running samples through the f32 core.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Replay {
+    pub y: Vec<f32>,
+    /// Samples whose output was held (non-finite input or overflow).
+    pub held: usize,
+}
+
+struct Run<'a> {
+    params: &'a [f32],
+    dt: f32,
+    rate: RateSpec,
+    samples: &'a [Sample],
+}
+
+impl Visit for Run<'_> {
+    type Out = Result<Replay, ParamError>;
+    fn visit<M: Model>(self) -> Self::Out {
+        let model = M::from_params(self.params, self.dt)?;
+        let est = Estimator::new(model, self.rate.build(self.dt)?)?;
+        let mut st = est.state();
+        let mut out = Replay { y: Vec::with_capacity(self.samples.len()), held: 0 };
+        for s in self.samples {
+            let o = est.step(&mut st, *s);
+            out.held += usize::from(!o.flags.ok());
+            out.y.push(o.y);
+        }
+        Ok(out)
+    }
+}
+
+/// Run `samples` through model `id` with flat parameters `params`, one step per sample
+/// of `dt` seconds, in f32 — the code the firmware runs.
+pub fn replay(id: &str, params: &[f32], dt: f32, rate: RateSpec, samples: &[Sample]) -> Result<Replay, ReplayError> {
+    visit(id, Run { params, dt, rate, samples })
+        .ok_or_else(|| ReplayError::UnknownModel(id.to_owned()))?
+        .map_err(|source| ReplayError::Params { model: id.to_owned(), source })
+}
+
+#[cfg(test)]
+mod sample_tests {
+    use super::*;
+
+    #[test]
+    fn every_registered_id_dispatches() {
+        struct Id;
+        impl Visit for Id {
+            type Out = &'static str;
+            fn visit<M: Model>(self) -> &'static str {
+                M::ID
+            }
+        }
+        for info in model_core::MODELS.iter() {
+            assert_eq!(visit(info.id, Id), Some(info.id));
+        }
+        assert_eq!(visit("nope", Id), None);
+    }
+
+    #[test]
+    fn algebraic_replay_and_errors() {
+        let s: Vec<Sample> = (0..4).map(|i| Sample::new(i as f32)).collect();
+        let r = replay("algebraic", &[2.0, 0.0, 0.0, 1.0], 0.01, RateSpec::Backward, &s).unwrap();
+        assert_eq!(r.y, vec![1.0, 3.0, 5.0, 7.0]);
+        assert!(matches!(replay("nope", &[], 0.01, RateSpec::Backward, &s), Err(ReplayError::UnknownModel(_))));
+        let e = replay("algebraic", &[1.0], 0.01, RateSpec::Backward, &s).unwrap_err();
+        assert!(e.to_string().contains("expected 4 parameters"), "{e}");
+    }
 }

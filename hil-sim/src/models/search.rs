@@ -16,7 +16,7 @@
 
 use serde::Serialize;
 
-use super::RateChoice;
+use super::RateSpec;
 
 /// Spreads of the training data that set the size of every search box.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -47,10 +47,10 @@ pub const RATE_BANDWIDTH_OF_FS: f64 = 1.0 / 60.0;
 ///
 /// A plain backward difference passes the sensor's quantisation noise straight into the
 /// `c·ẋ` terms (on `ranran_50.csv` this alone is an 18 N error while the damper rests).
-pub fn default_rate(s: &Scales) -> RateChoice {
+pub fn default_rate(s: &Scales) -> RateSpec {
     let w = 2.0 * std::f64::consts::PI * s.fs * RATE_BANDWIDTH_OF_FS;
     let r = (s.x.max(1e-12) * 1e-3).powi(2);
-    RateChoice::Kalman { q: (r * w.powi(6)) as f32, r: r as f32 }
+    RateSpec::Kalman { q: (r * w.powi(6)) as f32, r: r as f32 }
 }
 
 /// How a parameter is searched between its bounds.
@@ -206,7 +206,7 @@ pub struct ModelSpec {
     pub structure: Structure,
     /// Rate estimator the model is fitted and replayed with.
     #[serde(skip)]
-    pub rate: RateChoice,
+    pub rate: RateSpec,
 }
 
 impl ModelSpec {

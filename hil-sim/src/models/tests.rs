@@ -5,7 +5,7 @@ use super::search::*;
 use super::spencer::{DYKE_1997, DYKE_SCALES};
 use super::*;
 
-fn spec(id: &str, s: &Scales, rate: Option<RateChoice>) -> Option<ModelSpec> {
+fn spec(id: &str, s: &Scales, rate: Option<RateSpec>) -> Option<ModelSpec> {
     host(id)?.spec(s, rate)
 }
 

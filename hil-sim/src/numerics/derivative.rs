@@ -1,7 +1,7 @@
 //! The input's rate and acceleration for offline work (the diagnosis), without the phase
 //! lag of a causal estimator.
 //!
-//! The firmware's estimators ([`crate::models::RateChoice`]) are causal, so their rate
+//! The firmware's estimators ([`crate::models::RateSpec`]) are causal, so their rate
 //! lags the true one; a base model fitted through them carries that lag, and a diagnosis
 //! would report it as a `field_lag` of the clutch. Offline the whole recording is known:
 //! here the input is low-passed forward and backward (a first-order filter at
@@ -33,9 +33,22 @@ pub fn filtfilt(v: &[f64], tau_samples: f64) -> Vec<f64> {
 /// Zero-phase rate and acceleration of `x` sampled every `dt` seconds.
 pub fn rates(x: &[f64], dt: f64) -> (Vec<f64>, Vec<f64>) {
     let tau = 1.0 / (2.0 * std::f64::consts::PI * CUTOFF_OF_FS);
-    let dx = crate::models::replay::gradient(&filtfilt(x, tau), dt);
-    let ddx = crate::models::replay::gradient(&filtfilt(&dx, tau), dt);
+    let dx = gradient(&filtfilt(x, tau), dt);
+    let ddx = gradient(&filtfilt(&dx, tau), dt);
     (dx, ddx)
+}
+
+/// Central-difference derivative (one-sided at the ends).
+pub fn gradient(v: &[f64], dt: f64) -> Vec<f64> {
+    let n = v.len();
+    (0..n)
+        .map(|i| match (i.checked_sub(1).and_then(|j| v.get(j)), v.get(i + 1)) {
+            (Some(a), Some(b)) => (b - a) / (2.0 * dt),
+            (None, Some(b)) => (b - v[i]) / dt,
+            (Some(a), None) => (v[i] - a) / dt,
+            (None, None) => 0.0,
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -22,7 +22,7 @@ use serde::Serialize;
 use crate::ident::fit::simulate::{kinematics, Simulator};
 use crate::ident::fit::Dataset;
 use crate::models::search::{ModelSpec, Spacing};
-use crate::models::RateChoice;
+use crate::models::RateSpec;
 
 /// A change to what the base model is fed.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -91,7 +91,7 @@ pub struct Problem<'a> {
     pub data: &'a Dataset,
     pub sim: &'a dyn Simulator,
     pub spec: &'a ModelSpec,
-    pub rate: RateChoice,
+    pub rate: RateSpec,
     /// Training rows the refit uses (flagged samples and delay-uncovered edges left out).
     pub train: Vec<usize>,
 }

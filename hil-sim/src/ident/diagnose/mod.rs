@@ -37,7 +37,7 @@ use serde::Serialize;
 use thiserror::Error;
 
 use crate::ident::fit::{fit, Dataset, DelayChoice, FitError, FitOptions, FitResult};
-use crate::models::RateChoice;
+use crate::models::RateSpec;
 use crate::numerics::metrics::{metrics, Metrics};
 use augment::{Fitted, Problem, Term, Transform, Tune};
 use candidates::{AuxChannel, Candidate, Role};
@@ -90,7 +90,7 @@ pub struct DiagnoseOptions {
     pub heldout: f64,
     /// Rate estimator of the models; `None`: the zero-phase offline rate
     /// ([`crate::numerics::derivative`]), so that no estimator lag is mistaken for the clutch's.
-    pub rate: Option<RateChoice>,
+    pub rate: Option<RateSpec>,
     pub seed: u64,
     /// Rounds of naming and modelling.
     pub max_findings: usize,
@@ -835,7 +835,7 @@ mod tests {
         let rates = crate::numerics::derivative::rates(&seen, dt);
         let samples = crate::models::replay::samples_with_rates(&seen, None, Some(&rates));
         let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
-        let out = crate::models::replay("bouc_wen", &truth, dt as f32, RateChoice::Backward, &samples).unwrap();
+        let out = crate::models::replay("bouc_wen", &truth, dt as f32, RateSpec::Backward, &samples).unwrap();
         let y: Vec<f64> = out.y.iter().map(|v| f64::from(*v)).collect();
         let (lo, hi) = y.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
         let noise = 0.005 * (hi - lo);

@@ -147,7 +147,7 @@ mod tests {
     use super::*;
     use crate::ident::fit::simulate::{kinematics, simulator};
     use crate::models::search::Scales;
-    use crate::models::RateChoice;
+    use crate::models::RateSpec;
     use model_core::Sample;
 
     /// Recover a Bouc–Wen parameter set from its own noiseless output, starting away from it.
@@ -160,13 +160,13 @@ mod tests {
                 Sample::new((2.0 * t).sin() + 0.5 * (7.0 * t).sin())
             })
             .collect();
-        let kin = kinematics(&samples, dt, RateChoice::Backward).unwrap();
+        let kin = kinematics(&samples, dt, RateSpec::Backward).unwrap();
         let sim = simulator("bouc_wen", dt).unwrap();
         let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
         let mut y = vec![0.0; kin.len()];
         assert!(sim.run(&truth, &kin, &mut y));
         let sc = Scales { x_mean: 0.0, x: 0.8, dx: 1.5, ddx: 4.0, y_mean: 0.0, y: 2.0, u: None, fs: 1000.0 };
-        let sp = crate::models::host("bouc_wen").unwrap().spec(&sc, Some(RateChoice::Backward)).unwrap();
+        let sp = crate::models::host("bouc_wen").unwrap().spec(&sc, Some(RateSpec::Backward)).unwrap();
         let rows: Vec<usize> = (0..kin.len()).collect();
         let obj = Objective::new(sim.as_ref(), &sp, &kin, &y, &rows, 2.0);
         let start = [2.0, 1.0, 2.0, 1.0, 1.5, 0.2, 0.5, 0.1];

@@ -32,9 +32,10 @@ use thiserror::Error;
 
 use crate::io::params_file::{ParamsFile, Values};
 use crate::io::recording::{Recording, RecordingError};
-use crate::models::replay::{gradient, Channels};
+use crate::models::replay::Channels;
 use crate::models::search::{ModelSpec, Scales, Strategy, Structure};
-use crate::models::{replay, RateChoice};
+use crate::models::{replay, RateSpec};
+use crate::numerics::derivative::gradient;
 use crate::numerics::metrics::{metrics, Metrics};
 use global::SwarmOptions;
 use objective::Objective;
@@ -176,7 +177,7 @@ pub enum DelayChoice {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FitOptions {
     /// Rate estimator for every model (`None`: each model's preferred one).
-    pub rate: Option<RateChoice>,
+    pub rate: Option<RateSpec>,
     /// Input delay: fitted (default), off, or given.
     pub delay: DelayChoice,
     pub swarm: SwarmOptions,
@@ -246,19 +247,10 @@ pub struct FitResult {
     #[serde(skip)]
     pub flat: Vec<f64>,
     #[serde(skip)]
-    pub rate_choice: RateChoice,
+    pub rate_choice: RateSpec,
     /// The replayed output over the whole recording.
     #[serde(skip)]
     pub output: Vec<f64>,
-}
-
-/// `backward`, `filtered:FC`, `kalman:Q:R`, the syntax of `--rate`.
-pub fn rate_name(r: RateChoice) -> String {
-    match r {
-        RateChoice::Backward => "backward".into(),
-        RateChoice::Filtered(fc) => format!("filtered:{fc}"),
-        RateChoice::Kalman { q, r } => format!("kalman:{q}:{r}"),
-    }
 }
 
 /// Fit model `id` to `data`.
@@ -363,7 +355,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         heldout_unflagged: (unflagged.len() != all_heldout.len()).then(|| score(&unflagged)),
         fit_seconds,
         method: sp.strategy,
-        rate: rate_name(sp.rate),
+        rate: crate::models::rate::label(sp.rate),
         evaluations,
         replay_ns_per_sample: replay_ns,
         n_params: info.n_params,
@@ -612,7 +604,7 @@ mod tests {
             .collect();
         let u = command.then(|| time.iter().map(|t| 1.0 + 0.8 * (3.1 * t).sin()).collect::<Vec<f64>>());
         let samples = crate::models::replay::samples(&x_true, u.as_deref());
-        let out = replay(id, truth, dt as f32, RateChoice::Backward, &samples).unwrap();
+        let out = replay(id, truth, dt as f32, RateSpec::Backward, &samples).unwrap();
         // The logged input is the true one `lag` samples late: x_log(t) = x_true(t − lag).
         let input = crate::ident::alignment::shift(&x_true, -lag);
         Dataset {
@@ -630,7 +622,7 @@ mod tests {
     fn opts(delay: DelayChoice) -> FitOptions {
         // Noiseless data: let Levenberg–Marquardt run to convergence.
         FitOptions {
-            rate: Some(RateChoice::Backward),
+            rate: Some(RateSpec::Backward),
             delay,
             lm_iterations: 80,
             polish_iterations: 80,

@@ -22,7 +22,7 @@ use super::lm;
 use super::objective::Objective;
 use super::simulate::simulator_of;
 use crate::models::search::{ModelSpec, ParamSpec, Spacing, Strategy, Structure};
-use crate::models::RateChoice;
+use crate::models::RateSpec;
 
 /// Hidden units of the Hammerstein–Wiener networks that are trained (input, output side).
 pub const HW_TRAINED: (usize, usize) = (3, 3);
@@ -74,7 +74,7 @@ pub fn train(
     y: &[f64],
     rows: &[usize],
     dt: f32,
-    rate: RateChoice,
+    rate: RateSpec,
     iterations: usize,
     window: usize,
     seed: u64,

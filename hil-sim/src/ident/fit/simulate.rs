@@ -9,7 +9,7 @@ use std::marker::PhantomData;
 use model_core::rate::RateState;
 use model_core::{Kin, Model, Sample};
 
-use crate::models::{visit, RateChoice, Visit};
+use crate::models::{visit, RateSpec, Visit};
 
 /// Runs one model type, chosen at run time by id.
 pub trait Simulator: Send + Sync {
@@ -78,7 +78,7 @@ pub fn simulator_of<M: Model>(dt: f32) -> Box<dyn Simulator> {
 /// The kinematics the core sees for each sample, from the rate estimator `rate` exactly as
 /// [`model_core::Estimator::step`] computes them (a measured rate in the sample wins).
 /// `None` if the estimate overflows (the inputs are checked finite before).
-pub fn kinematics(samples: &[Sample], dt: f32, rate: RateChoice) -> Option<Vec<Kin>> {
+pub fn kinematics(samples: &[Sample], dt: f32, rate: RateSpec) -> Option<Vec<Kin>> {
     let params = rate.build(dt).ok()?;
     let mut st = RateState::default();
     let mut out = Vec::with_capacity(samples.len());
@@ -108,7 +108,7 @@ mod tests {
             })
             .collect();
         let spencer = [21.0, 3.5, 46.9, 283.0, 2.95, 5.0, 14.3, 140.0, 695.0, 363.0, 363.0, 301.0, 2.0, 190.0];
-        for rate in [RateChoice::Backward, RateChoice::Filtered(50.0)] {
+        for rate in [RateSpec::Backward, RateSpec::Filtered { fc: 50.0 }] {
             let kin = kinematics(&samples, dt, rate).unwrap();
             let sim = simulator("spencer", dt).unwrap();
             let mut out = vec![0.0; kin.len()];

@@ -239,7 +239,7 @@ fn diff_rms(a: &[f64], b: &[f64]) -> f64 {
 fn torque(base: &str, p: &[f32], b: &[f64], dt: f64) -> Result<Vec<f64>, ConcealedError> {
     let rates = crate::numerics::derivative::rates(b, dt);
     let samples = crate::models::replay::samples_with_rates(b, None, Some(&rates));
-    let r = crate::models::replay(base, p, dt as f32, crate::models::RateChoice::Backward, &samples)
+    let r = crate::models::replay(base, p, dt as f32, crate::models::RateSpec::Backward, &samples)
         .map_err(|_| ConcealedError::Diverged(base.to_owned()))?;
     if r.held > 0 {
         return Err(ConcealedError::Diverged(base.to_owned()));
