@@ -1,11 +1,10 @@
 use std::path::PathBuf;
 
-use anyhow::{bail, Context};
+use anyhow::bail;
 use clap::Args;
 use hil_sim::ident::compare::{compare, Named};
-use hil_sim::ident::fit::{Dataset, FitOptions};
-use hil_sim::io::recording::Recording;
-use hil_sim::quality;
+use hil_sim::ident::dataset::prepare;
+use hil_sim::ident::fit::FitOptions;
 use serde_json::json;
 
 use super::ChannelArgs;
@@ -33,16 +32,12 @@ pub struct CompareArgs {
 
 fn load(path: &std::path::Path, a: &CompareArgs, train: f64) -> anyhow::Result<Named> {
     let p = super::file_arg(path)?;
-    let rec = Recording::read(&p)?;
-    let ch = a.ch.channels();
-    let q = quality::check(&rec, &ch)?;
-    for w in &q.warnings {
+    let prepared = prepare(&p, &a.ch.channels(), train, a.ch.keep_flagged)?;
+    for w in &prepared.quality.warnings {
         eprintln!("warning: {}", w.message);
     }
-    let excluded = (!a.ch.keep_flagged).then(|| q.excluded());
-    let data = Dataset::new(&rec, &ch, train, excluded).with_context(|| format!("{}", p.display()))?;
     let name = p.file_stem().map_or_else(|| p.display().to_string(), |s| s.to_string_lossy().into_owned());
-    Ok(Named { name, data })
+    Ok(Named { name, data: prepared.data })
 }
 
 pub fn run(a: CompareArgs) -> anyhow::Result<()> {

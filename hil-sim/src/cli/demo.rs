@@ -3,12 +3,12 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::Args;
 use hil_sim::closed_loop::{compare as loop_compare, identify, multisine_reference, Run, T_START};
-use hil_sim::ident::fit::{Dataset, FitOptions, FitResult};
+use hil_sim::ident::dataset::{prepare, Dataset, Prepared};
+use hil_sim::ident::fit::{FitOptions, FitResult};
 use hil_sim::io::params_file::ParamsFile;
 use hil_sim::io::recording::Recording;
 use hil_sim::models::replay::{replay_recording, Channels};
 use hil_sim::models::RateSpec;
-use hil_sim::quality;
 use hil_sim::report::fit::{error_bars, fit_plots, results_table, Labels};
 use hil_sim::report::plot::{self, Series, Style};
 use hil_sim::report::Report;
@@ -43,14 +43,11 @@ fn dyke_channels() -> Channels {
 
 fn fit_dyke(file: &'static str) -> anyhow::Result<DykeFit> {
     let path = hil_sim::io::bundled::data_file(file).map_err(anyhow::Error::msg)?;
-    let rec = Recording::read(&path)?;
-    let ch = dyke_channels();
-    let q = quality::check(&rec, &ch)?;
+    let Prepared { recording: rec, quality: q, data } = prepare(&path, &dyke_channels(), TRAIN, false)?;
     let warnings: Vec<String> = q.warnings.iter().map(|w| w.message.clone()).collect();
     for w in &warnings {
         eprintln!("warning: {w}");
     }
-    let data = Dataset::new(&rec, &ch, TRAIN, Some(q.excluded())).with_context(|| path.display().to_string())?;
     let ids = super::fit::model_list("all")?;
     eprintln!("fitting {} models on {file}", ids.len());
     let results = super::fit::fit_all(&data, &ids, &FitOptions::default())?;

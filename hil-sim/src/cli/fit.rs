@@ -1,12 +1,11 @@
 use std::path::PathBuf;
-use std::time::Instant;
 
-use anyhow::{bail, Context};
+use anyhow::bail;
 use clap::Args;
-use hil_sim::ident::fit::{fit, Dataset, DelayChoice, FitOptions, FitResult};
-use hil_sim::io::params_file::ParamsFile;
-use hil_sim::io::recording::Recording;
-use hil_sim::quality;
+use hil_sim::ident::fit::job::{self, FitJob};
+use hil_sim::ident::fit::{Dataset, DelayChoice, FitOptions, FitResult};
+use hil_sim::report::fit::Labels;
+use hil_sim::report::fit_page;
 use serde_json::json;
 
 use super::ChannelArgs;
@@ -78,67 +77,48 @@ pub fn model_list(arg: &str) -> anyhow::Result<Vec<String>> {
     Ok(list)
 }
 
-/// Fit each model in `ids`, with a progress bar; results in the order of `ids`.
+/// Fit each model in `ids` on `data`, with a progress bar.
 pub fn fit_all(data: &Dataset, ids: &[String], opts: &FitOptions) -> anyhow::Result<Vec<FitResult>> {
-    let pb = super::progress(ids.len() as u64, "fitting");
-    // Models run one after another; each fit is parallel inside (swarm, Jacobian columns).
-    let mut out = Vec::with_capacity(ids.len());
-    for id in ids {
-        pb.set_message(id.clone());
-        let r = fit(id, data, opts).with_context(|| format!("fitting `{id}`"))?;
-        pb.inc(1);
-        out.push(r);
-    }
-    pb.finish_and_clear();
-    Ok(out)
+    let bar = super::progress::Bar::new(ids.len() as u64, "fitting");
+    Ok(job::fit_many(data, ids, opts, &bar)?)
 }
 
 pub fn run(a: FitArgs) -> anyhow::Result<()> {
-    let ids = model_list(&a.model)?;
-    let rate = a.ch.rate()?;
-    let path = super::file_arg(&a.rec)?;
-    let rec = Recording::read(&path)?;
-    let ch = a.ch.channels();
-    let q = quality::check(&rec, &ch)?;
+    let mut options = FitOptions { rate: a.ch.rate()?, delay: a.delay, ..Default::default() };
+    options.swarm.seed = a.seed;
+    let fit_job = FitJob {
+        recording: super::file_arg(&a.rec)?,
+        channels: a.ch.channels(),
+        train: a.train,
+        keep_flagged: a.ch.keep_flagged,
+        models: model_list(&a.model)?,
+        options,
+        save: a.save.clone(),
+    };
+    let bar = super::progress::Bar::new(fit_job.models.len() as u64, "fitting");
+    let run = job::run(&fit_job, &bar).map_err(|e| match &e {
+        job::FitJobError::Dataset(d) if d.train_fraction().is_some() => {
+            anyhow::anyhow!("--train {}: must be a fraction strictly between 0 and 1", a.train)
+        }
+        _ => e.into(),
+    })?;
+    bar.finish();
+    let (path, data, q) = (&fit_job.recording, &run.prepared.data, &run.prepared.quality);
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
     }
-    let excluded = (!a.ch.keep_flagged).then(|| q.excluded());
-    let data = Dataset::new(&rec, &ch, a.train, excluded).with_context(|| format!("{}", path.display()))?;
-    let mut opts = FitOptions { rate, delay: a.delay, ..Default::default() };
-    opts.swarm.seed = a.seed;
-    let t0 = Instant::now();
-    let results = fit_all(&data, &ids, &opts)?;
-    let total = t0.elapsed().as_secs_f64();
-    for r in &results {
+    for r in &run.results {
         for w in &r.warnings {
             eprintln!("warning: {}: {w}", r.model);
         }
     }
-    if let Some(dir) = &a.save {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        for r in &results {
-            let flat: Vec<f32> = r.flat.iter().map(|v| *v as f32).collect();
-            let mut pf = ParamsFile::from_flat(&r.model, Some(format!("hil-sim fit {}", path.display())), &flat)
-                .context("building the parameter file")?;
-            pf.rate = Some(r.rate.clone());
-            pf.delay_s = (r.delay_s != 0.0).then_some(r.delay_s);
-            pf.command_delay_s = (r.command_delay_s != 0.0).then_some(r.command_delay_s);
-            let file = dir.join(format!("{}.json", r.model));
-            std::fs::write(&file, serde_json::to_string_pretty(&pf)? + "\n")
-                .with_context(|| format!("writing {}", file.display()))?;
-        }
-    }
-    let best = results
-        .iter()
-        .filter(|r| r.heldout.rmse.is_finite())
-        .min_by(|x, y| x.heldout.rmse.total_cmp(&y.heldout.rmse))
-        .map(|r| r.model.clone());
     if let Some(dir) = &a.out {
         let title = format!("Fit of {}", path.display());
-        let index = write_report(dir, &title, &data, &results, &a.ch.input, &a.ch.output)?;
+        let labels = Labels { input: a.ch.input.clone(), output: a.ch.output.clone() };
+        let index = fit_page::write(dir, &title, data, &run.results, &labels)?;
         eprintln!("report written to {}", index.display());
     }
+    let best = run.best().map(|r| r.model.clone());
     if a.json {
         return super::print_json(&json!({
             "recording": path.display().to_string(),
@@ -149,9 +129,9 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
             "heldout_samples": data.len() - data.train_end,
             "warnings": q.warnings,
             "excluded_samples": if a.ch.keep_flagged { 0 } else { q.excluded_samples },
-            "results": results,
+            "results": run.results,
             "best": best,
-            "total_seconds": total,
+            "total_seconds": run.total_seconds,
         }));
     }
     super::emit(&format!(
@@ -163,9 +143,9 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
         data.train_end,
         data.len() - data.train_end
     ));
-    super::emit(&table(&results));
+    super::emit(&table(&run.results));
     if let Some(b) = best {
-        super::emit(&format!("\nbest held-out: {b}; total {total:.2} s\n"));
+        super::emit(&format!("\nbest held-out: {b}; total {:.2} s\n", run.total_seconds));
     }
     Ok(())
 }
@@ -204,43 +184,4 @@ pub fn table(results: &[FitResult]) -> String {
         );
     }
     s
-}
-
-/// Write a fit report: the table, the error bars, and the plots of the best model (by
-/// held-out RMSE). Returns the path of `index.html`.
-pub fn write_report(
-    dir: &std::path::Path,
-    title: &str,
-    data: &Dataset,
-    results: &[FitResult],
-    input: &str,
-    output: &str,
-) -> anyhow::Result<PathBuf> {
-    use hil_sim::report::fit::{error_bars, fit_plots, loop_plots, results_table, Labels};
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let mut rep = hil_sim::report::Report::new(title);
-    rep.paragraph(&format!(
-        "{} samples at {:.1} Hz; fitted on the first {} samples, scored on the last {}. Metrics are from the \
-         f32 replay through model-core (the firmware's code), one step per sample.",
-        data.len(),
-        1.0 / data.dt,
-        data.train_end,
-        data.len() - data.train_end
-    ));
-    results_table(&mut rep, results);
-    let stem = |m: &str| format!("fit_{m}");
-    error_bars(&mut rep, dir, "fit", results)?;
-    let labels = Labels { input: input.to_owned(), output: output.to_owned() };
-    if let Some(best) = results.iter().min_by(|x, y| x.heldout.rmse.total_cmp(&y.heldout.rmse)) {
-        rep.heading(&format!("Best held-out model: {}", best.model));
-        fit_plots(&mut rep, dir, &stem(&best.model), data, best, &labels)?;
-    }
-    for r in results.iter().filter(|r| !r.warnings.is_empty()) {
-        for w in &r.warnings {
-            rep.paragraph(&format!("**Warning ({}):** {w}", r.model));
-        }
-    }
-    rep.heading("Hysteresis loops of every model (held-out part)");
-    loop_plots(&mut rep, dir, "heldout", data, results, &labels)?;
-    Ok(rep.write(dir)?)
 }

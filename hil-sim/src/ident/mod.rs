@@ -3,5 +3,6 @@
 
 pub mod alignment;
 pub mod compare;
+pub mod dataset;
 pub mod diagnose;
 pub mod fit;

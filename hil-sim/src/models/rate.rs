@@ -11,9 +11,9 @@ pub const SEED_002_KALMAN: RateSpec = RateSpec::Kalman { q: 200.0, r: 0.01 };
 /// A rate estimator's text that does not parse.
 #[derive(Debug, Error, PartialEq)]
 pub enum RateParseError {
-    #[error("`{text}`: `{part}` is not a number")]
+    #[error("{text}: `{part}` is not a number")]
     NotANumber { text: String, part: String },
-    #[error("`{0}`: expected backward, filtered:FC_HZ or kalman[:Q:R]")]
+    #[error("{0}: expected backward, filtered:FC_HZ or kalman[:Q:R]")]
     Unknown(String),
 }
 

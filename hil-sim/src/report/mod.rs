@@ -249,4 +249,5 @@ mod tests {
 }
 
 pub mod fit;
+pub mod fit_page;
 pub mod plot;

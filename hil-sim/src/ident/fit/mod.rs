@@ -15,6 +15,7 @@
 //!   from a replay through [`crate::models::replay`] — the `Estimator` path, f32.
 
 pub mod global;
+pub mod job;
 pub mod linear;
 pub mod lm;
 pub mod narx;
@@ -25,32 +26,25 @@ pub mod simulate;
 
 use std::time::Instant;
 
-use model_core::Sample;
 use rayon::prelude::*;
 use serde::Serialize;
 use thiserror::Error;
 
 use crate::io::params_file::{ParamsFile, Values};
-use crate::io::recording::{Recording, RecordingError};
-use crate::models::replay::Channels;
 use crate::models::search::{ModelSpec, Scales, Strategy, Structure};
 use crate::models::{replay, RateSpec};
 use crate::numerics::derivative::gradient;
 use crate::numerics::metrics::{metrics, Metrics};
 use global::SwarmOptions;
+
+pub use crate::ident::dataset::{Dataset, DatasetError};
 use objective::Objective;
 
 /// Why a fit could not run.
 #[derive(Debug, Error)]
 pub enum FitError {
     #[error(transparent)]
-    Recording(#[from] RecordingError),
-    #[error("--train {0}: must be a fraction strictly between 0 and 1")]
-    TrainFraction(f64),
-    #[error("the training part has only {0} usable samples (need at least 20)")]
-    TooFewSamples(usize),
-    #[error("the held-out part is empty (lower --train)")]
-    NoHeldOut,
+    Dataset(#[from] DatasetError),
     #[error("unknown model `{0}` (see `hil-sim models`)")]
     UnknownModel(String),
     #[error("model `{0}` is not fitted by this build")]
@@ -63,102 +57,6 @@ pub enum FitError {
     Swarm { model: String, reason: String },
     #[error("{model}: replay of the fitted set failed: {reason}")]
     Replay { model: String, reason: String },
-}
-
-/// The data a fit works on.
-#[derive(Clone, Debug)]
-pub struct Dataset {
-    /// Mean sample interval, seconds: the core's fixed step.
-    pub dt: f64,
-    pub time: Vec<f64>,
-    pub input: Vec<f64>,
-    pub output: Vec<f64>,
-    pub command: Option<Vec<f64>>,
-    /// First held-out sample.
-    pub train_end: usize,
-    /// Samples the quality checks flagged: excluded from the fit (the model still runs
-    /// through them) and scored separately.
-    pub excluded: Vec<bool>,
-    /// Given rate and acceleration of the input (e.g. [`crate::numerics::derivative::rates`]): fed to
-    /// the models instead of the rate estimator's when present.
-    pub rates: Option<(Vec<f64>, Vec<f64>)>,
-}
-
-impl Dataset {
-    /// Take the channels `ch` of `rec` and split at `train` (fraction of the samples, time-ordered).
-    /// `excluded` marks flagged samples (`None`: none).
-    pub fn new(rec: &Recording, ch: &Channels, train: f64, excluded: Option<Vec<bool>>) -> Result<Self, FitError> {
-        if !(train > 0.0 && train < 1.0) {
-            return Err(FitError::TrainFraction(train));
-        }
-        let time = rec.time(&ch.time)?.to_vec();
-        let input = rec.channel(&ch.input)?.to_vec();
-        let output = rec.channel(&ch.output)?.to_vec();
-        let command = ch.command.as_deref().map(|c| rec.channel(c).map(<[f64]>::to_vec)).transpose()?;
-        let dt = rec.mean_dt(&ch.time)?;
-        let n = input.len();
-        let train_end = ((n as f64) * train).round() as usize;
-        if train_end >= n {
-            return Err(FitError::NoHeldOut);
-        }
-        let excluded = excluded.filter(|e| e.len() == n).unwrap_or_else(|| vec![false; n]);
-        let d = Self { dt, time, input, output, command, train_end, excluded, rates: None };
-        let usable = d.train_rows().len();
-        if usable < 20 {
-            return Err(FitError::TooFewSamples(usable));
-        }
-        Ok(d)
-    }
-
-    pub fn len(&self) -> usize {
-        self.input.len()
-    }
-    pub fn is_empty(&self) -> bool {
-        self.input.is_empty()
-    }
-
-    /// The samples as the core sees them (f32, with the command when there is one, and the
-    /// given rates when there are some).
-    pub fn samples(&self) -> Vec<Sample> {
-        crate::models::replay::samples_with_rates(&self.input, self.command.as_deref(), self.rates.as_ref())
-    }
-
-    /// Training samples that enter the fit.
-    pub fn train_rows(&self) -> Vec<usize> {
-        (0..self.train_end).filter(|&i| !self.excluded.get(i).copied().unwrap_or(false)).collect()
-    }
-
-    /// Held-out samples the quality checks did not flag.
-    pub fn heldout_unflagged(&self) -> Vec<usize> {
-        (self.train_end..self.len()).filter(|&i| !self.excluded.get(i).copied().unwrap_or(false)).collect()
-    }
-
-    /// Spreads of the training part (see [`Scales`]).
-    pub fn scales(&self) -> Scales {
-        let rows = self.train_rows();
-        let pick = |v: &[f64]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
-        let mean_std = |v: &[f64]| {
-            let n = v.len().max(1) as f64;
-            let m = v.iter().sum::<f64>() / n;
-            (m, (v.iter().map(|a| (a - m) * (a - m)).sum::<f64>() / n).sqrt())
-        };
-        let x = pick(&self.input);
-        let dx = gradient(&self.input, self.dt);
-        let ddx = gradient(&dx, self.dt);
-        let (x_mean, xs) = mean_std(&x);
-        let (y_mean, ys) = mean_std(&pick(&self.output));
-        let u = self.command.as_ref().map(|u| pick(u).iter().fold(0.0f64, |a, b| a.max(b.abs())));
-        Scales {
-            x_mean,
-            x: xs,
-            dx: mean_std(&pick(&dx)).1,
-            ddx: mean_std(&pick(&ddx)).1,
-            y_mean,
-            y: ys,
-            u: u.filter(|u| *u > 0.0),
-            fs: 1.0 / self.dt,
-        }
-    }
 }
 
 /// Whether the fit aligns the input channel with the output ([`crate::ident::alignment`]).

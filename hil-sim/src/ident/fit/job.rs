@@ -1,0 +1,111 @@
+//! `fit` as one call: read and check a recording, fit every named model with progress,
+//! save each fitted set as a parameter file.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use thiserror::Error;
+
+use super::{fit, FitError, FitOptions, FitResult};
+use crate::ident::dataset::{prepare, DatasetError, Prepared};
+use crate::io::params_file::ParamsFile;
+use crate::models::replay::Channels;
+use crate::progress::Progress;
+
+/// What to fit, on what.
+#[derive(Clone, Debug)]
+pub struct FitJob {
+    pub recording: PathBuf,
+    pub channels: Channels,
+    /// Fraction of the recording (time-ordered, from the start) fitted; the rest is scored.
+    pub train: f64,
+    /// Keep the samples the quality checks flag in the fit.
+    pub keep_flagged: bool,
+    pub models: Vec<String>,
+    pub options: FitOptions,
+    /// Write each fitted set as `<dir>/<model>.json`.
+    pub save: Option<PathBuf>,
+}
+
+/// The outcome of a [`FitJob`].
+#[derive(Clone, Debug)]
+pub struct FitRun {
+    pub prepared: Prepared,
+    /// One per model, in the job's order.
+    pub results: Vec<FitResult>,
+    /// Parameter files written.
+    pub saved: Vec<PathBuf>,
+    /// Wall time of the fits, seconds.
+    pub total_seconds: f64,
+}
+
+impl FitRun {
+    /// The model with the lowest held-out RMSE.
+    pub fn best(&self) -> Option<&FitResult> {
+        self.results
+            .iter()
+            .filter(|r| r.heldout.rmse.is_finite())
+            .min_by(|x, y| x.heldout.rmse.total_cmp(&y.heldout.rmse))
+    }
+}
+
+/// Why a fit job stopped.
+#[derive(Debug, Error)]
+pub enum FitJobError {
+    #[error(transparent)]
+    Dataset(#[from] DatasetError),
+    #[error("fitting `{model}`: {source}")]
+    Fit { model: String, source: FitError },
+    #[error("{}: {reason}", path.display())]
+    Save { path: PathBuf, reason: String },
+}
+
+/// Fit each model in `ids` on `data`, one progress step per model; results in the order of `ids`.
+pub fn fit_many(
+    data: &crate::ident::dataset::Dataset,
+    ids: &[String],
+    opts: &FitOptions,
+    progress: &dyn Progress,
+) -> Result<Vec<FitResult>, FitJobError> {
+    progress.stage("fitting", ids.len() as u64);
+    let mut out = Vec::with_capacity(ids.len());
+    for id in ids {
+        progress.message(id);
+        out.push(fit(id, data, opts).map_err(|source| FitJobError::Fit { model: id.clone(), source })?);
+        progress.advance(1);
+    }
+    Ok(out)
+}
+
+/// Run the job: prepare the recording, fit, save.
+pub fn run(job: &FitJob, progress: &dyn Progress) -> Result<FitRun, FitJobError> {
+    let prepared = prepare(&job.recording, &job.channels, job.train, job.keep_flagged)?;
+    let t0 = Instant::now();
+    let results = fit_many(&prepared.data, &job.models, &job.options, progress)?;
+    let total_seconds = t0.elapsed().as_secs_f64();
+    let saved = match &job.save {
+        Some(dir) => save(dir, &results, &job.recording)?,
+        None => Vec::new(),
+    };
+    Ok(FitRun { prepared, results, saved, total_seconds })
+}
+
+/// Write each result as `<dir>/<model>.json`, a `replay --params` file naming its source.
+pub fn save(dir: &Path, results: &[FitResult], recording: &Path) -> Result<Vec<PathBuf>, FitJobError> {
+    let err = |path: &Path, reason: String| FitJobError::Save { path: path.to_owned(), reason };
+    std::fs::create_dir_all(dir).map_err(|e| err(dir, format!("cannot create: {e}")))?;
+    let mut written = Vec::with_capacity(results.len());
+    for r in results {
+        let file = dir.join(format!("{}.json", r.model));
+        let flat: Vec<f32> = r.flat.iter().map(|v| *v as f32).collect();
+        let mut pf = ParamsFile::from_flat(&r.model, Some(format!("hil-sim fit {}", recording.display())), &flat)
+            .ok_or_else(|| err(&file, "cannot build the parameter file".into()))?;
+        pf.rate = Some(r.rate.clone());
+        pf.delay_s = (r.delay_s != 0.0).then_some(r.delay_s);
+        pf.command_delay_s = (r.command_delay_s != 0.0).then_some(r.command_delay_s);
+        let text = serde_json::to_string_pretty(&pf).map_err(|e| err(&file, e.to_string()))? + "\n";
+        std::fs::write(&file, text).map_err(|e| err(&file, format!("cannot write: {e}")))?;
+        written.push(file);
+    }
+    Ok(written)
+}
