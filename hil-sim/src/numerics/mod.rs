@@ -2,5 +2,6 @@
 //! sampled signals, the papers' error metrics.
 
 pub mod derivative;
+pub mod lstsq;
 pub mod metrics;
 pub mod nnls;

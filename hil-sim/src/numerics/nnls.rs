@@ -4,35 +4,11 @@
 //! No maintained Rust crate solves this on nalgebra matrices (the `nnls` crate works on
 //! ndarray and has no free, unconstrained columns), and the problems here have at most a
 //! dozen columns, so the active-set loop is written out; each subproblem is solved by SVD
-//! with a relative cut-off like [`super::linear`].
+//! with a relative cut-off ([`super::lstsq::solve_svd`]).
 
 use nalgebra::{DMatrix, DVector};
 
-/// Normal equations `AᵀA`, `Aᵀb` of the columns `cols` at the rows `rows` (`b = y`).
-pub fn normal_equations(cols: &[Vec<f64>], y: &[f64], rows: &[usize]) -> (DMatrix<f64>, DVector<f64>) {
-    let n = cols.len();
-    let mut gram = DMatrix::<f64>::zeros(n, n);
-    let mut atb = DVector::<f64>::zeros(n);
-    let mut a = vec![0.0; n];
-    for &i in rows {
-        let (Some(&yi), true) = (y.get(i), cols.iter().all(|c| i < c.len())) else { continue };
-        for (v, c) in a.iter_mut().zip(cols) {
-            *v = c.get(i).copied().unwrap_or(0.0);
-        }
-        for r in 0..n {
-            atb[r] += a[r] * yi;
-            for c in 0..=r {
-                gram[(r, c)] += a[r] * a[c];
-            }
-        }
-    }
-    for r in 0..n {
-        for c in 0..r {
-            gram[(c, r)] = gram[(r, c)];
-        }
-    }
-    (gram, atb)
-}
+pub use super::lstsq::normal_equations;
 
 /// Unconstrained solution restricted to the columns in `set` (others 0).
 fn solve_subset(gram: &DMatrix<f64>, atb: &DVector<f64>, set: &[usize]) -> Option<DVector<f64>> {
@@ -43,9 +19,7 @@ fn solve_subset(gram: &DMatrix<f64>, atb: &DVector<f64>, set: &[usize]) -> Optio
     }
     let g = DMatrix::from_fn(k, k, |r, c| gram[(set[r], set[c])]);
     let b = DVector::from_fn(k, |r, _| atb[set[r]]);
-    let svd = g.svd(true, true);
-    let cut = 1e-12 * svd.singular_values.max();
-    let z = svd.solve(&b, cut).ok()?;
+    let z = super::lstsq::solve_svd(g, &b, 1e-12)?;
     for (r, &j) in set.iter().enumerate() {
         out[j] = z[r];
     }

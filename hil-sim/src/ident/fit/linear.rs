@@ -9,6 +9,7 @@ use model_core::Kin;
 use nalgebra::{DMatrix, DVector};
 
 use crate::models::MAX_REGRESSORS;
+use crate::numerics::lstsq;
 
 /// Regressor row of model `id` at one sample (`None` for a model that is not linear);
 /// each model writes its own in its host file ([`crate::models::HostModel::regressors`]).
@@ -42,31 +43,13 @@ pub fn solve(id: &str, kin: &[Kin], y: &[f64], rows: &[usize], free: &[usize], p
         for (c, &j) in free.iter().enumerate() {
             a[c] = *phi.get(j)?;
         }
-        for r in 0..n {
-            atb[r] += a[r] * b;
-            for c in 0..=r {
-                gram[(r, c)] += a[r] * a[c];
-            }
-        }
+        lstsq::accumulate(&mut gram, &mut atb, &a[..n], b);
     }
-    for r in 0..n {
-        for c in 0..r {
-            gram[(c, r)] = gram[(r, c)];
-        }
-    }
-    let scale: Vec<f64> = (0..n).map(|c| gram[(c, c)].sqrt()).map(|v| if v > 0.0 { 1.0 / v } else { 0.0 }).collect();
-    for r in 0..n {
-        atb[r] *= scale[r];
-        for c in 0..n {
-            gram[(r, c)] *= scale[r] * scale[c];
-        }
-    }
-    let svd = gram.svd(true, true);
-    let cut = 1e-13 * svd.singular_values.max();
-    let sol = svd.solve(&atb, cut).ok()?;
+    lstsq::symmetrize(&mut gram);
+    let sol = lstsq::solve_scaled(gram, atb, 1e-13)?;
     let mut out = p.to_vec();
     for (c, &j) in free.iter().enumerate() {
-        *out.get_mut(j)? = sol[c] * scale.get(c).copied().unwrap_or(0.0);
+        *out.get_mut(j)? = sol[c];
     }
     Some(out)
 }

@@ -1,0 +1,90 @@
+//! Linear least squares on the normal equations of small problems (a few dozen columns at
+//! most): accumulate `AᵀA`, `Aᵀb` row by row without an m×n matrix, then solve by SVD with a
+//! relative cut-off (a column the data does not excite gets a zero coefficient instead of a
+//! blow-up), or by Cholesky with a ridge. The sign-constrained variant is [`super::nnls`].
+
+use nalgebra::{DMatrix, DVector};
+
+/// Add one row `a` with target `b` to the lower triangle of `gram` and to `atb`.
+pub fn accumulate(gram: &mut DMatrix<f64>, atb: &mut DVector<f64>, a: &[f64], b: f64) {
+    for r in 0..atb.len() {
+        atb[r] += a[r] * b;
+        for c in 0..=r {
+            gram[(r, c)] += a[r] * a[c];
+        }
+    }
+}
+
+/// Copy the lower triangle of `gram` to the upper one.
+pub fn symmetrize(gram: &mut DMatrix<f64>) {
+    for r in 0..gram.nrows() {
+        for c in 0..r {
+            gram[(c, r)] = gram[(r, c)];
+        }
+    }
+}
+
+/// Normal equations `AᵀA`, `Aᵀb` of the columns `cols` at the rows `rows` (`b = y`).
+pub fn normal_equations(cols: &[Vec<f64>], y: &[f64], rows: &[usize]) -> (DMatrix<f64>, DVector<f64>) {
+    let n = cols.len();
+    let mut gram = DMatrix::<f64>::zeros(n, n);
+    let mut atb = DVector::<f64>::zeros(n);
+    let mut a = vec![0.0; n];
+    for &i in rows {
+        let (Some(&yi), true) = (y.get(i), cols.iter().all(|c| i < c.len())) else { continue };
+        for (v, c) in a.iter_mut().zip(cols) {
+            *v = c.get(i).copied().unwrap_or(0.0);
+        }
+        accumulate(&mut gram, &mut atb, &a, yi);
+    }
+    symmetrize(&mut gram);
+    (gram, atb)
+}
+
+/// Solve `g·θ = b` by SVD, singular values below `rcond` × the largest cut off.
+pub fn solve_svd(g: DMatrix<f64>, b: &DVector<f64>, rcond: f64) -> Option<DVector<f64>> {
+    let svd = g.svd(true, true);
+    let cut = rcond * svd.singular_values.max();
+    svd.solve(b, cut).ok()
+}
+
+/// [`solve_svd`] on the normal equations with every column scaled to unit norm first (so
+/// the cut-off is relative per column, whatever the columns' units); the solution in the
+/// original scaling.
+pub fn solve_scaled(mut gram: DMatrix<f64>, mut atb: DVector<f64>, rcond: f64) -> Option<DVector<f64>> {
+    let n = atb.len();
+    let scale: Vec<f64> = (0..n).map(|c| gram[(c, c)].sqrt()).map(|v| if v > 0.0 { 1.0 / v } else { 0.0 }).collect();
+    for r in 0..n {
+        atb[r] *= scale[r];
+        for c in 0..n {
+            gram[(r, c)] *= scale[r] * scale[c];
+        }
+    }
+    let sol = solve_svd(gram, &atb, rcond)?;
+    Some(DVector::from_fn(n, |c, _| sol[c] * scale.get(c).copied().unwrap_or(0.0)))
+}
+
+/// Solve `g·θ = b` by Cholesky (`g` symmetric positive definite, e.g. normal equations
+/// with a ridge on the diagonal); SVD with an absolute cut-off `svd_eps` when Cholesky fails.
+pub fn solve_cholesky(g: DMatrix<f64>, b: &DVector<f64>, svd_eps: f64) -> Option<DVector<f64>> {
+    g.clone().cholesky().map(|ch| ch.solve(b)).or_else(|| g.svd(true, true).solve(b, svd_eps).ok())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn recovers_a_line_and_zeroes_an_unexcited_column() {
+        let rows: Vec<usize> = (0..50).collect();
+        let x: Vec<f64> = rows.iter().map(|&i| i as f64 / 10.0).collect();
+        let cols = vec![x.clone(), vec![1.0; 50], vec![0.0; 50]];
+        let y: Vec<f64> = x.iter().map(|v| 3.0 * v - 2.0).collect();
+        let (g, b) = normal_equations(&cols, &y, &rows);
+        let th = solve_scaled(g.clone(), b.clone(), 1e-13).unwrap();
+        assert!((th[0] - 3.0).abs() < 1e-9 && (th[1] + 2.0).abs() < 1e-9 && th[2] == 0.0, "{th:?}");
+        let ridge = DMatrix::from_fn(3, 3, |r, c| g[(r, c)] + if r == c { 1e-9 } else { 0.0 });
+        let th = solve_cholesky(ridge, &b, 1e-12).unwrap();
+        assert!((th[0] - 3.0).abs() < 1e-6, "{th:?}");
+    }
+}
