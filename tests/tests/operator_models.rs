@@ -7,11 +7,9 @@
 //! (seed 000 eq. 18–19, the board's size) is at least as accurate on the held-out part as
 //! the best parametric model.
 
-use std::path::Path;
 use std::sync::OnceLock;
 
 use hil_sim::ident::fit::{fit, Dataset, FitOptions, FitResult};
-use hil_sim::io::recording::Recording;
 use hil_sim::models::replay::Channels;
 use hil_sim::quality;
 use hil_sim::sim::scenario::Scenario;
@@ -26,7 +24,7 @@ fn dataset(name: &str, duration: Option<f64>, ch: &Channels, train: f64) -> Data
         sc.duration_s = d;
     }
     let rec = sc.record().expect("simulation");
-    let recording = Recording::parse_csv(Path::new(&format!("{name}.csv")), rec.csv.as_bytes()).expect("csv");
+    let recording = rec.recording;
     let q = quality::check(&recording, ch).expect("quality checks");
     Dataset::new(&recording, ch, train, Some(q.excluded())).expect("dataset")
 }

@@ -108,11 +108,12 @@ pub fn run_cmd(a: SimulateArgs) -> anyhow::Result<()> {
     let pb = super::progress(1, &sc.name);
     let rec = sc.record()?;
     pb.finish_and_clear();
-    let (csv, rows, r, k0) = (rec.csv, rec.rows, rec.run, rec.first);
+    let (rows, r, k0) = (rec.recording.len(), &rec.run, rec.first);
     if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    std::fs::write(&a.out, csv).with_context(|| format!("writing {}", a.out.display()))?;
+    let file = std::fs::File::create(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
+    rec.recording.write_csv(std::io::BufWriter::new(file)).with_context(|| format!("writing {}", a.out.display()))?;
     let (tmin, tmax) = r.torque_true[k0..].iter().fold((f64::MAX, f64::MIN), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
     let theta_end = r.temperature.last().copied().unwrap_or(f64::NAN);
     if a.json {
@@ -120,7 +121,7 @@ pub fn run_cmd(a: SimulateArgs) -> anyhow::Result<()> {
             "scenario": sc.name, "description": sc.description, "out": a.out, "rows": rows,
             "record_hz": sc.record_hz, "control_hz": sc.control_hz,
             "torque_range": [tmin, tmax], "temperature_end_c": theta_end,
-            "columns": ["t", "b", "torque", "i", "i_ref", "duty", "speed", "temperature", "torque_true"],
+            "columns": hil_sim::sim::scenario::RECORD_COLUMNS,
         }));
     }
     super::emit(&format!(

@@ -28,6 +28,7 @@ use rand::{Rng, SeedableRng};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use crate::io::recording::{Column, Recording};
 use crate::sim::excitation::Excitation;
 use crate::sim::plant::ClutchParams;
 
@@ -328,16 +329,16 @@ impl Scenario {
 
 /// A simulated recording of a current-driven scenario, as `hil-sim simulate` writes it.
 pub struct Recorded {
-    /// CSV text: `t,b,torque,i,i_ref,duty,speed,temperature,torque_true`.
-    pub csv: String,
-    pub rows: usize,
+    /// The channels [`RECORD_COLUMNS`] at the recording rate, each to the resolution it is
+    /// recorded with (e.g. 10 µs in time, 1 µT in the field).
+    pub recording: Recording,
     /// The whole run at the control rate (from the start of calibration).
     pub run: crate::closed_loop::Run,
     /// First sample of `run` after calibration.
     pub first: usize,
 }
 
-/// Column names of [`Recorded::csv`].
+/// Column names of [`Recorded::recording`].
 pub const RECORD_COLUMNS: [&str; 9] = ["t", "b", "torque", "i", "i_ref", "duty", "speed", "temperature", "torque_true"];
 
 impl Scenario {
@@ -351,25 +352,35 @@ impl Scenario {
         let r = run(&self.clutch, &step, cfg, &reference, T_START + dur, self.seed, None);
         let every = (self.control_hz / self.record_hz).round().max(1.0) as usize;
         let k0 = r.after(T_START);
-        let mut csv = RECORD_COLUMNS.join(",") + "\n";
-        let mut rows = 0usize;
-        for k in (k0..r.t.len()).step_by(every) {
-            csv += &format!(
-                "{:.5},{:.6},{:.5},{:.5},{:.5},{:.5},{:.3},{:.3},{:.5}\n",
-                r.t[k] - T_START,
-                r.b[k],
-                r.load_cell[k],
-                r.current[k],
-                r.i_ref[k],
-                r.duty[k],
-                r.speed[k],
-                r.temperature[k],
-                r.torque_true[k]
-            );
-            rows += 1;
-        }
-        Ok(Recorded { csv, rows, run: r, first: k0 })
+        let ks: Vec<usize> = (k0..r.t.len()).step_by(every).collect();
+        let t: Vec<f64> = r.t.iter().map(|t| t - T_START).collect();
+        let signals: [(&[f64], usize); 9] = [
+            (&t, 5),
+            (&r.b, 6),
+            (&r.load_cell, 5),
+            (&r.current, 5),
+            (&r.i_ref, 5),
+            (&r.duty, 5),
+            (&r.speed, 3),
+            (&r.temperature, 3),
+            (&r.torque_true, 5),
+        ];
+        let columns = RECORD_COLUMNS
+            .iter()
+            .zip(signals)
+            .map(|(name, (v, decimals))| Column {
+                name: (*name).to_owned(),
+                values: ks.iter().map(|&k| resolution(v.get(k).copied().unwrap_or(f64::NAN), decimals)).collect(),
+            })
+            .collect();
+        let recording = Recording::from_columns(Path::new(&format!("{}.csv", self.name)), columns, Vec::new());
+        Ok(Recorded { recording, run: r, first: k0 })
     }
+}
+
+/// `v` to `decimals` decimal places, as a recorder with that resolution stores it.
+fn resolution(v: f64, decimals: usize) -> f64 {
+    format!("{v:.decimals$}").parse().unwrap_or(v)
 }
 
 #[cfg(test)]
