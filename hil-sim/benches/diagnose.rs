@@ -8,8 +8,8 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use hil_sim::ident::diagnose::{diagnose, DiagnoseOptions};
 use hil_sim::ident::fit::Dataset;
+use hil_sim::io::recording::Channels;
 use hil_sim::io::recording::Recording;
-use hil_sim::models::replay::Channels;
 use hil_sim::sim::concealed::{generate, ConcealedSpec};
 
 fn bench(c: &mut Criterion) {

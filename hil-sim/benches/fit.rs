@@ -5,8 +5,8 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use hil_sim::ident::fit::{fit, Dataset, DelayChoice, FitOptions};
+use hil_sim::io::recording::Channels;
 use hil_sim::io::recording::Recording;
-use hil_sim::models::replay::Channels;
 use hil_sim::models::{replay, RateSpec};
 use model_core::Sample;
 

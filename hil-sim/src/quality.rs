@@ -17,8 +17,8 @@
 
 use serde::Serialize;
 
+use crate::io::recording::Channels;
 use crate::io::recording::{Recording, RecordingError};
-use crate::models::replay::Channels;
 
 /// What a warning is about.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

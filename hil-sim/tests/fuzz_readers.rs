@@ -30,7 +30,7 @@ fn consistent(r: &Result<Recording, RecordingError>, name: &str) -> Result<(), T
             }
             prop_assert!(rec.constants.iter().all(|c| c.1.is_finite()));
             // Whatever parses also goes through the quality check without panicking.
-            let _ = hil_sim::quality::check(rec, &hil_sim::models::replay::Channels::default());
+            let _ = hil_sim::quality::check(rec, &hil_sim::io::recording::Channels::default());
         }
         Err(e) => {
             let m = e.to_string();

@@ -3,8 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
+use hil_sim::io::recording::Channels;
 use hil_sim::io::recording::Recording;
-use hil_sim::models::replay::Channels;
 use hil_sim::quality::{check, WarningKind};
 
 fn dyke(name: &str) -> PathBuf {

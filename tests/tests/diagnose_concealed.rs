@@ -22,8 +22,8 @@ use std::path::Path;
 
 use hil_sim::ident::diagnose::{diagnose, DiagnoseOptions};
 use hil_sim::ident::fit::Dataset;
+use hil_sim::io::recording::Channels;
 use hil_sim::io::recording::Recording;
-use hil_sim::models::replay::Channels;
 use hil_sim::sim::concealed::{generate, ConcealedSpec};
 
 const EFFECTS: [&str; 9] = [

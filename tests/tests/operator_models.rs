@@ -10,7 +10,7 @@
 use std::sync::OnceLock;
 
 use hil_sim::ident::fit::{fit, Dataset, FitOptions, FitResult};
-use hil_sim::models::replay::Channels;
+use hil_sim::io::recording::Channels;
 use hil_sim::quality;
 use hil_sim::sim::scenario::Scenario;
 use model_core::models::prandtl_ishlinskii::PrandtlIshlinskii;

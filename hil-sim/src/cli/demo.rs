@@ -6,8 +6,9 @@ use hil_sim::closed_loop::{compare as loop_compare, identify, multisine_referenc
 use hil_sim::ident::dataset::{prepare, Dataset, Prepared};
 use hil_sim::ident::fit::{FitOptions, FitResult};
 use hil_sim::io::params_file::ParamsFile;
+use hil_sim::io::recording::Channels;
 use hil_sim::io::recording::Recording;
-use hil_sim::models::replay::{replay_recording, Channels};
+use hil_sim::models::replay::replay_recording;
 use hil_sim::models::RateSpec;
 use hil_sim::report::fit::{error_bars, fit_plots, results_table, Labels};
 use hil_sim::report::plot::{self, Series, Style};

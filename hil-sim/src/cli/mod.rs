@@ -18,7 +18,7 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use clap::{Args, Parser, Subcommand};
-use hil_sim::models::replay::Channels;
+use hil_sim::io::recording::Channels;
 use hil_sim::models::RateSpec;
 
 #[derive(Parser, Debug)]
@@ -115,7 +115,7 @@ impl ChannelArgs {
 }
 
 pub fn parse_rate(s: &str) -> anyhow::Result<RateSpec> {
-    hil_sim::models::rate::parse(s).map_err(|e| anyhow::anyhow!("--rate {e}"))
+    hil_sim::io::rate::parse(s).map_err(|e| anyhow::anyhow!("--rate {e}"))
 }
 
 /// Print one JSON object on stdout.

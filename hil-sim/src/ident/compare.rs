@@ -210,8 +210,8 @@ impl Comparison {
 mod tests {
     use super::*;
     use crate::ident::fit::simulate::{kinematics, simulator};
+    use crate::io::recording::Channels;
     use crate::io::recording::{Column, Recording};
-    use crate::models::replay::Channels;
     use crate::models::RateSpec;
     use crate::sim::excitation::Excitation;
     use std::path::Path;

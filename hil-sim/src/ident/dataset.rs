@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use model_core::Sample;
 use thiserror::Error;
 
+use crate::io::recording::Channels;
 use crate::io::recording::{Recording, RecordingError};
-use crate::models::replay::Channels;
 use crate::models::search::Scales;
 use crate::numerics::derivative::gradient;
 use crate::quality::{self, Quality};

@@ -1,7 +1,6 @@
 //! Identification: fit a model to recordings, compare models across recordings, diagnose
 //! what a model misses.
 
-pub mod alignment;
 pub mod compare;
 pub mod dataset;
 pub mod diagnose;

@@ -4,4 +4,5 @@
 pub mod bundled;
 pub mod config_page;
 pub mod params_file;
+pub mod rate;
 pub mod recording;

@@ -51,7 +51,7 @@ pub struct ParamsFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rate: Option<String>,
     /// Input delay the set was fitted with, seconds: replay feeds the model `x(t + delay_s)`
-    /// (see `hil_sim::ident::alignment`). Absent means 0.
+    /// (see `hil_sim::models::alignment`). Absent means 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub delay_s: Option<f64>,
     /// Command delay, seconds: replay feeds the model `u(t + command_delay_s)`. Absent means 0.

@@ -3,7 +3,7 @@
 //! values for identification, its f64 reference, the accuracy check of the f32 core.
 
 pub mod accuracy;
-pub mod rate;
+pub mod alignment;
 pub mod reference;
 pub mod replay;
 pub mod search;
@@ -132,7 +132,7 @@ pub fn host(id: &str) -> Option<&'static Host> {
     HOSTS.iter().find(|h| h.id == id)
 }
 
-pub use rate::RateSpec;
+pub use model_core::control::RateSpec;
 pub use replay::{replay, Replay, ReplayError};
 
 #[cfg(test)]

@@ -6,26 +6,9 @@ use model_core::{Estimator, Model, ParamError, Sample};
 use serde::Serialize;
 use thiserror::Error;
 
-use crate::io::recording::Recording;
+use crate::io::recording::{Channels, Recording};
 use crate::models::{visit, RateSpec, Visit};
 use crate::numerics::metrics::{metrics, Metrics};
-
-/// Which columns play which role.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Channels {
-    pub time: String,
-    pub input: String,
-    pub output: String,
-    /// Channel driving current/voltage-dependent parameters, if any.
-    pub command: Option<String>,
-}
-
-impl Default for Channels {
-    /// The contract's defaults for an MR clutch: `t`, `b`, `torque`.
-    fn default() -> Self {
-        Self { time: "t".into(), input: "b".into(), output: "torque".into(), command: None }
-    }
-}
 
 /// What a replay measured.
 #[derive(Clone, Debug, Serialize)]
@@ -45,7 +28,7 @@ pub struct ReplayReport {
 }
 
 /// Replay `rec` through `model` with flat `params`, the input and the command read
-/// `delays_s` later ([`crate::ident::alignment`]; 0 for none); errors are one line of text.
+/// `delays_s` later ([`crate::models::alignment`]; 0 for none).
 pub fn replay_recording(
     rec: &Recording,
     ch: &Channels,
@@ -53,14 +36,14 @@ pub fn replay_recording(
     params: &[f32],
     rate: RateSpec,
     delays_s: (f64, f64),
-) -> anyhow::Result<ReplayReport> {
+) -> Result<ReplayReport, ReplayError> {
     let t = rec.time(&ch.time)?;
     let x = rec.channel(&ch.input)?;
     let y = rec.channel(&ch.output)?;
     let u = ch.command.as_deref().map(|c| rec.channel(c)).transpose()?;
     let dt = rec.mean_dt(&ch.time)?;
     let (d, d_u) = (delays_s.0 / dt, if u.is_some() { delays_s.1 / dt } else { 0.0 });
-    let (x, u) = crate::ident::alignment::shift_channels(x, u, d, d_u);
+    let (x, u) = crate::models::alignment::shift_channels(x, u, d, d_u);
     let samples = samples(&x, u.as_deref());
     let out = replay(model, params, dt as f32, rate, &samples)?;
     let model_output: Vec<f64> = out.y.iter().map(|v| f64::from(*v)).collect();
@@ -68,7 +51,7 @@ pub fn replay_recording(
     let dx = crate::numerics::derivative::gradient(&x, dt);
     let ddx = crate::numerics::derivative::gradient(&dx, dt);
     // Samples whose shifted channels read past the recording's ends are not scored.
-    let (lo, hi) = crate::ident::alignment::covered(x.len(), &[d, d_u]);
+    let (lo, hi) = crate::models::alignment::covered(x.len(), &[d, d_u]);
     let part = |v: &[f64]| v.get(lo..hi).unwrap_or(&[]).to_vec();
     Ok(ReplayReport {
         model: model.to_owned(),
@@ -112,6 +95,8 @@ pub fn samples(x: &[f64], u: Option<&[f64]>) -> Vec<Sample> {
 /// Why a replay could not start.
 #[derive(Debug, Error)]
 pub enum ReplayError {
+    #[error(transparent)]
+    Recording(#[from] crate::io::recording::RecordingError),
     #[error("unknown model `{0}` (see `hil-sim models`)")]
     UnknownModel(String),
     #[error("model `{model}`: {source}")]

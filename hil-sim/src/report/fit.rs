@@ -70,7 +70,7 @@ pub fn fit_plots(
     let (la, lb) = span(t, t_split - 1.0, t_split + 0.5);
     let name = format!("{stem}_loop.svg");
     // Against the input as the model saw it (shifted by the fitted delay).
-    let x = crate::ident::alignment::shift(&data.input, r.delay_s / data.dt);
+    let x = crate::models::alignment::shift(&data.input, r.delay_s / data.dt);
     let x_label = if r.delay_s == 0.0 {
         labels.input.clone()
     } else {

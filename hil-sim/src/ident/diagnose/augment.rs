@@ -42,7 +42,7 @@ impl Transform {
     /// The transformed input; `dt` is the sample interval (s).
     pub fn apply(&self, x: &[f64], dt: f64) -> Vec<f64> {
         match *self {
-            Self::Delay { delay_s } => crate::ident::alignment::shift(x, -delay_s / dt),
+            Self::Delay { delay_s } => crate::models::alignment::shift(x, -delay_s / dt),
             Self::Lag { tau_s } => {
                 let a = if tau_s > 0.0 { (-dt / tau_s).exp() } else { 0.0 };
                 let mut f = x.first().copied().unwrap_or(0.0);

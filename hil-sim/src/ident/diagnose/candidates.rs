@@ -319,7 +319,7 @@ pub fn all(data: &Dataset, aux: &[AuxChannel]) -> Vec<Candidate> {
             channel: Some(s.name.clone()),
         });
         let tau = 20.0 * dt / (2.0 * std::f64::consts::PI);
-        let smooth = crate::ident::alignment::shift(&lowpass(&s.values, tau, dt), tau / dt);
+        let smooth = crate::models::alignment::shift(&lowpass(&s.values, tau, dt), tau / dt);
         let acc = crate::numerics::derivative::gradient(&smooth, dt);
         out.push(Candidate {
             effect: "inertia",

@@ -9,7 +9,7 @@ use thiserror::Error;
 use super::{fit, FitError, FitOptions, FitResult};
 use crate::ident::dataset::{prepare, DatasetError, Prepared};
 use crate::io::params_file::ParamsFile;
-use crate::models::replay::Channels;
+use crate::io::recording::Channels;
 use crate::progress::Progress;
 
 /// What to fit, on what.

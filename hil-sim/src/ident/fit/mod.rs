@@ -59,7 +59,7 @@ pub enum FitError {
     Replay { model: String, reason: String },
 }
 
-/// Whether the fit aligns the input channel with the output ([`crate::ident::alignment`]).
+/// Whether the fit aligns the input channel with the output ([`crate::models::alignment`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum DelayChoice {
     /// No shift: the channels are taken as recorded.
@@ -172,7 +172,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         (DelayChoice::Fixed(s, s_u), _) => {
             let d = (s / data.dt, if data.command.is_some() { s_u / data.dt } else { 0.0 });
             let mut shifted = Vec::new();
-            crate::ident::alignment::shift_kin(&kin, d.0, d.1, &mut shifted);
+            crate::models::alignment::shift_kin(&kin, d.0, d.1, &mut shifted);
             (fit_at(&shifted, &sp)?, d)
         }
         // A network has past inputs for the lags it needs.
@@ -189,7 +189,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         (DelayChoice::Auto, _) => {
             let spd = sp.clone().with_delays(
                 data.command.is_some() && uses_command(id, &scales),
-                crate::ident::alignment::MAX_DELAY_SAMPLES,
+                crate::models::alignment::MAX_DELAY_SAMPLES,
             );
             let (p, e) = fit_at(&kin, &spd)?;
             let d = (p.get(n_model).copied().unwrap_or(0.0), p.get(n_model + 1).copied().unwrap_or(0.0));
@@ -201,7 +201,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     let mut warnings = Vec::new();
     if sp.structure == Structure::AsymmetricBoucWen {
         let mut shifted = Vec::new();
-        crate::ident::alignment::shift_kin(&kin, delay, delay_u, &mut shifted);
+        crate::models::alignment::shift_kin(&kin, delay, delay_u, &mut shifted);
         if operator::abw_crossing(&params, dt, &shifted, &rows) == Some(true) {
             let eq = if params.get(11).copied() == Some(1.0) { "eq. 30" } else { "eq. 31" };
             warnings.push(format!(
@@ -215,14 +215,14 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     let p32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
     // The channels as the model saw them (as recorded when no delay was fitted).
     let (input, command) =
-        crate::ident::alignment::shift_channels(&data.input, data.command.as_deref(), delay, delay_u);
+        crate::models::alignment::shift_channels(&data.input, data.command.as_deref(), delay, delay_u);
     let samples = if delay == 0.0 && delay_u == 0.0 {
         samples
     } else {
         let rates = data
             .rates
             .as_ref()
-            .map(|(dx, ddx)| (crate::ident::alignment::shift(dx, delay), crate::ident::alignment::shift(ddx, delay)));
+            .map(|(dx, ddx)| (crate::models::alignment::shift(dx, delay), crate::models::alignment::shift(ddx, delay)));
         crate::models::replay::samples_with_rates(&input, command.as_deref(), rates.as_ref())
     };
     let t0 = Instant::now();
@@ -238,7 +238,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     };
     // A delayed channel has no data for the first or last few samples: those are not scored.
     let n = data.len();
-    let (lo, hi) = crate::ident::alignment::covered(n, &[delay, delay_u]);
+    let (lo, hi) = crate::models::alignment::covered(n, &[delay, delay_u]);
     let unflagged: Vec<usize> = data.heldout_unflagged().into_iter().filter(|i| (lo..hi).contains(i)).collect();
     let all_heldout: Vec<usize> = (data.train_end..n).filter(|i| (lo..hi).contains(i)).collect();
     let rows: Vec<usize> = rows.into_iter().filter(|i| (lo..hi).contains(i)).collect();
@@ -253,7 +253,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         heldout_unflagged: (unflagged.len() != all_heldout.len()).then(|| score(&unflagged)),
         fit_seconds,
         method: sp.strategy,
-        rate: crate::models::rate::label(sp.rate),
+        rate: crate::io::rate::label(sp.rate),
         evaluations,
         replay_ns_per_sample: replay_ns,
         n_params: info.n_params,
@@ -438,7 +438,7 @@ fn global_search(
     Ok((best, evals))
 }
 
-/// Fit at every whole-sample delay in ±[`MAX_DELAY_SAMPLES`](crate::ident::alignment::MAX_DELAY_SAMPLES)
+/// Fit at every whole-sample delay in ±[`MAX_DELAY_SAMPLES`](crate::models::alignment::MAX_DELAY_SAMPLES)
 /// (`at` fits on the shifted kinematics and returns the fit and its training cost), then
 /// refine the best by a parabola through it and its neighbours. Returns the best fit and
 /// its delay in samples. For the closed-form models, where a fit costs one pass.
@@ -449,10 +449,10 @@ fn scan_delay<T>(
 where
     T: Send,
 {
-    let m = crate::ident::alignment::MAX_DELAY_SAMPLES as i32;
+    let m = crate::models::alignment::MAX_DELAY_SAMPLES as i32;
     let fit_shifted = |d: f64| {
         let mut shifted = Vec::new();
-        crate::ident::alignment::shift_kin(kin, d, 0.0, &mut shifted);
+        crate::models::alignment::shift_kin(kin, d, 0.0, &mut shifted);
         at(&shifted).map(|(r, c)| (r, c, d))
     };
     let mut grid: Vec<Option<(T, f64, f64)>> = (-m..=m).into_par_iter().map(|d| fit_shifted(f64::from(d))).collect();
@@ -504,7 +504,7 @@ mod tests {
         let samples = crate::models::replay::samples(&x_true, u.as_deref());
         let out = replay(id, truth, dt as f32, RateSpec::Backward, &samples).unwrap();
         // The logged input is the true one `lag` samples late: x_log(t) = x_true(t − lag).
-        let input = crate::ident::alignment::shift(&x_true, -lag);
+        let input = crate::models::alignment::shift(&x_true, -lag);
         Dataset {
             dt,
             time,

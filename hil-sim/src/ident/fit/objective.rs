@@ -6,7 +6,7 @@ use std::sync::{Arc, Mutex};
 use model_core::Kin;
 
 use super::simulate::Simulator;
-use crate::ident::alignment::{shift_kin, MAX_DELAY_SAMPLES};
+use crate::models::alignment::{shift_kin, MAX_DELAY_SAMPLES};
 use crate::models::search::ModelSpec;
 
 /// Kinematics shifted by an (input, command) delay pair, in samples.
@@ -18,7 +18,7 @@ type ShiftedKin = ((f64, f64), Arc<Vec<Kin>>);
 /// whole history) but only `rows` (training samples not flagged by the quality checks)
 /// enter the sum. When the spec carries more entries than the model has parameters, the
 /// first is an input delay and the second a command delay, in samples
-/// ([`crate::ident::alignment`]), fitted with the rest. Residuals are divided by `scale` (the output's spread) so that the
+/// ([`crate::models::alignment`]), fitted with the rest. Residuals are divided by `scale` (the output's spread) so that the
 /// tolerances of the optimisers mean the same thing in every unit.
 pub struct Objective<'a> {
     pub sim: &'a dyn Simulator,

@@ -12,8 +12,6 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-use crate::models::replay::Channels;
-
 /// Why a recording could not be read.
 #[derive(Debug, Error)]
 pub enum RecordingError {
@@ -67,6 +65,23 @@ pub enum Format {
 pub struct Column {
     pub name: String,
     pub values: Vec<f64>,
+}
+
+/// Which columns play which role.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Channels {
+    pub time: String,
+    pub input: String,
+    pub output: String,
+    /// Channel driving current/voltage-dependent parameters, if any.
+    pub command: Option<String>,
+}
+
+impl Default for Channels {
+    /// The contract's defaults for an MR clutch: `t`, `b`, `torque`.
+    fn default() -> Self {
+        Self { time: "t".into(), input: "b".into(), output: "torque".into(), command: None }
+    }
 }
 
 /// A recording: equally long numeric columns, plus single values given only on the
