@@ -8,24 +8,25 @@
 //!
 //! `m` is a virtual mass (N·s² per unit x), constant in the command (seed 001 Fig. 10: every
 //! parameter but `m` varies almost linearly with the current); the other ten parameters and
-//! their command dependence are those of [`Arctan`]. Any finite `m` is accepted (the paper
+//! their command dependence are those of [`Arctan`](super::arctan::Arctan). Any finite `m` is accepted (the paper
 //! fits it freely). `ẍ` is [`Kin::ddx`]: with backward differences it is noisy, and `m·ẍ`
 //! passes that noise straight to the output (on top of the `sgn(ẍ)` chattering described
 //! in [`arctan`](super::arctan)), so pair the model with a smoothing rate estimator.
 //! With `m = 0` the model is exactly eq. 16.
 
-use crate::error::{count, finite};
+use crate::error::{count, finite, time_step};
 use crate::model::write_flat;
-use crate::models::arctan::{Arctan, Params};
+pub use crate::models::kernels::arctan_law::Params;
 use crate::{Kin, Model, ParamError};
 
 /// Validated coefficients of eq. 17.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ArctanInertia {
     /// The eq. 16 part.
-    pub base: Arctan,
+    p: Params,
     /// m: virtual mass, N·s² per unit x.
-    pub m: f32,
+    m: f32,
+    dt: f32,
 }
 
 /// No state.
@@ -33,9 +34,21 @@ pub type State = ();
 pub type Registered = ArctanInertia;
 
 impl ArctanInertia {
-    /// The bounds of [`Arctan::new`], and a finite `m`.
+    /// The bounds of [`Arctan::new`](crate::models::arctan::Arctan::new), and a finite `m`.
     pub fn new(p: Params, m: f32, dt: f32) -> Result<Self, ParamError> {
-        Ok(Self { base: Arctan::new(p, dt)?, m: finite("m", m)? })
+        let dt = time_step(dt)?;
+        p.validate()?;
+        Ok(Self { p, m: finite("m", m)?, dt })
+    }
+
+    /// The eq. 16 parameters.
+    pub fn params(&self) -> &Params {
+        &self.p
+    }
+
+    /// The virtual mass m, N·s² per unit x.
+    pub fn m(&self) -> f32 {
+        self.m
     }
 }
 
@@ -57,17 +70,17 @@ impl Model for ArctanInertia {
     }
 
     fn write_params(&self, out: &mut [f32]) -> usize {
-        let [a0, a1, b0, b1, c0, c1, d0, d1, e0, e1] = self.base.p.flat();
+        let [a0, a1, b0, b1, c0, c1, d0, d1, e0, e1] = self.p.flat();
         write_flat(&[a0, a1, b0, b1, c0, c1, d0, d1, e0, e1, self.m], out)
     }
 
     fn dt(&self) -> f32 {
-        self.base.dt()
+        self.dt
     }
 
     #[inline]
     fn step(&self, _state: &mut (), k: &Kin) -> f32 {
-        self.base.force(k) + self.m * k.ddx
+        self.p.force(k) + self.m * k.ddx
     }
 }
 

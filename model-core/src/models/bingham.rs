@@ -25,6 +25,7 @@
 
 use crate::error::{check, count, finite, time_step};
 use crate::model::write_flat;
+use crate::models::kernels::poly::poly;
 use crate::{Kin, Model, ParamError};
 
 /// Coefficients of seed 003 eq. 12–14.
@@ -46,12 +47,6 @@ pub type Registered = Bingham;
 /// Seed 003 eq. 13–14 with f0 = 40 N (RD-1005-3, x in mm, F in N, current in A).
 pub const SEED003: ([f32; 4], [f32; 5], f32) =
     ([52.19, 663.56, 986.49, -910.09], [0.53, 1.43, 66.00, -106.39, 48.74], 40.0);
-
-/// Horner evaluation of `c[0] + c[1]·u + c[2]·u² + …`.
-#[inline]
-pub(crate) fn poly(c: &[f32], u: f32) -> f32 {
-    c.iter().rev().fold(0.0, |acc, &ck| acc * u + ck)
-}
 
 impl Bingham {
     /// Every coefficient finite; `fc0 ≥ 0` and `c0_0 ≥ 0` (a passive damper at zero command).

@@ -84,7 +84,7 @@
 
 use crate::error::{check, count, finite, time_step};
 use crate::math::{abs, atan, clamp, expm1, powf, sign, sqrt, tanh};
-use crate::models::lugre::TURN_EPS;
+use crate::models::kernels::turning::{turning_point, TURN_EPS};
 
 /// Largest `q·|Δx|` (plus the reversal term) of the short-step path. A zero crossing inside
 /// such a step is off by at most `y²/2` of z* (see the module doc), so 2e-4.
@@ -461,27 +461,6 @@ fn region_n2(v0: f32, l: f32, p: f32, q: f32) -> Leg {
     }
     let v = s * (v0 - s * t) / (s - v0 * t);
     Leg::Done(if v > 0.0 { v } else { 0.0 })
-}
-
-/// The input's extremum inside the step `(t_{k−1}, t_k]`, if `k.dx`, `k.ddx` place one there
-/// and it lies beyond both `x_prev` and `k.x` (see the module doc). Shared with `lugre`.
-#[inline]
-pub(crate) fn turning_point(x_prev: f32, k: &Kin, dt: f32) -> Option<f32> {
-    let (dx, ddx) = (k.dx, k.ddx);
-    if !(dx != 0.0 && ddx != 0.0) {
-        return None;
-    }
-    let tau = dx / ddx;
-    if !(tau > 0.0 && tau < dt) {
-        return None;
-    }
-    let xt = k.x - 0.5 * dx * tau;
-    let s = sign(dx);
-    if (x_prev - xt) * s > 0.0 && (k.x - xt) * s > 0.0 && xt.is_finite() {
-        Some(xt)
-    } else {
-        None
-    }
 }
 
 impl Model for BoucWen {

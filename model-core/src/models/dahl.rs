@@ -35,7 +35,7 @@
 use crate::error::{check, count, finite, time_step};
 use crate::math::{abs, expm1};
 use crate::model::write_flat;
-use crate::models::spencer::{command, raw_command, CommandFilter};
+use crate::models::kernels::command_filter::{command, raw_command, CommandFilter};
 use crate::{Finite, Kin, Model, ParamError};
 
 /// The eight parameters of eq. 8–11 (seed 001 lists them).

@@ -36,7 +36,7 @@
 use crate::error::{check, count, finite, time_step};
 use crate::math::{exp, tanh};
 use crate::model::write_flat;
-use crate::models::prandtl_ishlinskii::operator_count;
+use crate::models::kernels::operators::operator_count;
 use crate::{Finite, Kin, Model, ParamError};
 
 /// Envelope family of eq. 19–21.

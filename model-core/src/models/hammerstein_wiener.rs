@@ -27,89 +27,16 @@
 //! gain `Σb/(1 + Σf)` times x, clamped), so a constant input gives a constant output.
 
 use crate::error::{check, count, time_step};
-use crate::math::{clamp, exp};
+use crate::math::clamp;
 use crate::model::write_flat;
+use crate::models::kernels::flat::take;
+use crate::models::kernels::names::BlockName;
+use crate::models::kernels::sigmoid::sigmoid;
+pub use crate::models::kernels::sigmoid::W_MAX;
 use crate::{Finite, Kin, Model, ParamError};
 
-/// Largest admissible magnitude of any weight.
-pub const W_MAX: f32 = 1.0e6;
 /// Clamp of the Hammerstein output x.
 const X_LIM: f32 = 1.0e20;
-
-/// Logistic sigmoid `1/(1 + e^{−s})`, total (0 at −∞, 1 at +∞). Shared with `narx`.
-#[inline]
-pub(crate) fn sigmoid(s: f32) -> f32 {
-    1.0 / (1.0 + exp(-s))
-}
-
-/// A block name `base[len]` built at compile time (for const-generic `PARAM_NAMES`).
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct BlockName {
-    buf: [u8; 32],
-    len: usize,
-}
-
-impl BlockName {
-    /// `base` (≤ 20 ASCII bytes) followed by `[len]`.
-    ///
-    /// Used only to initialise associated constants, i.e. evaluated by the compiler. The
-    /// indices stay in bounds by construction (≤ 20 + 1 + 10 + 1 = 32 bytes), and in const
-    /// evaluation an out-of-bounds index would be a compile error, not a run-time panic.
-    #[allow(clippy::indexing_slicing)]
-    pub(crate) const fn new(base: &str, n: usize) -> Self {
-        let mut buf = [0u8; 32];
-        let b = base.as_bytes();
-        let mut i = 0;
-        while i < b.len() && i < 20 {
-            buf[i] = b[i];
-            i += 1;
-        }
-        buf[i] = b'[';
-        i += 1;
-        let mut digits = [0u8; 10];
-        let mut nd = 0;
-        let mut v = n;
-        loop {
-            digits[nd] = b'0' + (v % 10) as u8;
-            nd += 1;
-            v /= 10;
-            if v == 0 || nd == digits.len() {
-                break;
-            }
-        }
-        while nd > 0 {
-            nd -= 1;
-            buf[i] = digits[nd];
-            i += 1;
-        }
-        buf[i] = b']';
-        i += 1;
-        Self { buf, len: i }
-    }
-
-    pub(crate) const fn as_str(&'static self) -> &'static str {
-        let (head, _) = self.buf.split_at(self.len);
-        match core::str::from_utf8(head) {
-            Ok(s) => s,
-            Err(_) => "?",
-        }
-    }
-}
-
-/// Read `N` values from a flat-vector iterator, validating each.
-pub(crate) fn take<const N: usize>(
-    it: &mut core::slice::Iter<'_, f32>,
-    name: &'static str,
-    lo: f32,
-    hi: f32,
-) -> Result<[f32; N], ParamError> {
-    let mut out = [0.0f32; N];
-    for o in out.iter_mut() {
-        let v = *it.next().ok_or(ParamError::Constraint { what: "parameter vector too short" })?;
-        *o = check(name, v, lo, hi)?;
-    }
-    Ok(out)
-}
 
 /// A scalar sigmoid network `lin·u + d + Σ aᵢ·σ(wᵢ·u + bᵢ)`.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -32,7 +32,7 @@
 use crate::error::{check, count, finite, time_step};
 use crate::math::{abs, clamp, expm1};
 use crate::model::write_flat;
-use crate::models::bouc_wen::turning_point;
+use crate::models::kernels::turning::{turning_point, TURN_EPS};
 use crate::{Finite, Kin, Model, ParamError};
 
 /// Coefficients of eq. 7–8.
@@ -61,9 +61,6 @@ pub struct LuGre {
 
 /// Largest `α·|ΔB|` (plus the reversal term) handled by the short-step series.
 pub(crate) const FAST_Y: f32 = 1.0 / 16.0;
-/// Largest `α·|B̈|·dt²` (the z change a reversal inside the step could make) for which the
-/// short-step path ignores the reversal.
-pub(crate) const TURN_EPS: f32 = 2.0e-3;
 
 /// `(1 − e^{−y})/y` for `|y| ≤ FAST_Y`: Taylor to y³ (error ≤ y⁴/120).
 #[inline(always)]

@@ -20,7 +20,8 @@
 use crate::error::{check, count, finite, time_step};
 use crate::math::clamp;
 use crate::model::write_flat;
-use crate::models::prandtl_ishlinskii::{block_names, operator_count, pick, to_array, MAX_OPERATORS};
+use crate::models::kernels::names::{block_names, pick};
+use crate::models::kernels::operators::{operator_count, to_array, MAX_OPERATORS};
 use crate::{Finite, Kin, Model, ParamError};
 
 const K_BLOCKS: [&str; MAX_OPERATORS + 1] = block_names!("k");

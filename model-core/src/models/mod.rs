@@ -4,6 +4,9 @@
 //! its `State`, and `pub type Registered = …;` — the concrete type (for const-generic
 //! models, the default size) listed by [`registry`](crate::registry).
 
+// Shared pieces (no model module uses another).
+pub(crate) mod kernels;
+
 // Seed 000 (Yang & Kermani 2023), input B.
 pub mod algebraic;
 pub mod bouc_wen;

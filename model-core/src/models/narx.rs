@@ -37,7 +37,9 @@
 use crate::error::{check, count, time_step};
 use crate::math::clamp;
 use crate::model::write_flat;
-use crate::models::hammerstein_wiener::{sigmoid, take, BlockName, W_MAX};
+use crate::models::kernels::flat::take;
+use crate::models::kernels::names::BlockName;
+use crate::models::kernels::sigmoid::{sigmoid, W_MAX};
 use crate::{Finite, Kin, Model, ParamError};
 
 /// Clamp of the normalised inputs.

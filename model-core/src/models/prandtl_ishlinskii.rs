@@ -19,36 +19,10 @@
 
 use crate::error::{check, count, finite, time_step};
 use crate::model::write_flat;
+use crate::models::kernels::names::{block_names, pick};
+pub use crate::models::kernels::operators::MAX_OPERATORS;
+use crate::models::kernels::operators::{operator_count, to_array};
 use crate::{Finite, Kin, Model, ParamError};
-
-/// Largest operator count with a parameter name table (`r[N]`, `p[N]`).
-pub const MAX_OPERATORS: usize = 64;
-
-/// Generates `["name[0]", "name[1]", …, "name[64]"]` for block parameter names.
-macro_rules! block_names {
-    ($name:literal) => {
-        $crate::models::prandtl_ishlinskii::block_names!(@ $name;
-            0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30
-            31 32 33 34 35 36 37 38 39 40 41 42 43 44 45 46 47 48 49 50 51 52 53 54 55 56 57 58
-            59 60 61 62 63 64)
-    };
-    (@ $name:literal; $($n:literal)*) => {
-        [$(concat!($name, "[", $n, "]")),*]
-    };
-}
-pub(crate) use block_names;
-
-/// Entry `n` of a name table in a const context (`"?"` past its end).
-pub(crate) const fn pick(mut table: &'static [&'static str], mut n: usize) -> &'static str {
-    while let [first, rest @ ..] = table {
-        if n == 0 {
-            return first;
-        }
-        n -= 1;
-        table = rest;
-    }
-    "?"
-}
 
 const R_BLOCKS: [&str; MAX_OPERATORS + 1] = block_names!("r");
 const P_BLOCKS: [&str; MAX_OPERATORS + 1] = block_names!("p");
@@ -102,24 +76,6 @@ impl<const N: usize> PrandtlIshlinskii<N> {
     pub fn inverse(&self) -> Result<Inverse<N>, ParamError> {
         Inverse::of(self)
     }
-}
-
-/// `1 ≤ n ≤ MAX_OPERATORS`.
-pub(crate) fn operator_count(n: usize) -> Result<(), ParamError> {
-    if n == 0 || n > MAX_OPERATORS {
-        Err(ParamError::Constraint { what: "operator count must be 1..=64" })
-    } else {
-        Ok(())
-    }
-}
-
-/// Copy `src` into a fixed array (length checked by the caller).
-pub(crate) fn to_array<const N: usize>(src: &[f32]) -> [f32; N] {
-    let mut a = [0.0; N];
-    for (o, s) in a.iter_mut().zip(src) {
-        *o = *s;
-    }
-    a
 }
 
 impl<const N: usize> Model for PrandtlIshlinskii<N> {

@@ -35,7 +35,7 @@
 use crate::error::{count, finite, time_step};
 use crate::math::{atan, sign, sin};
 use crate::model::write_flat;
-use crate::models::bingham::poly;
+use crate::models::kernels::poly::poly;
 use crate::{Kin, Model, ParamError};
 
 /// Upper end of the current range the constructor checks the polynomials over, A.
