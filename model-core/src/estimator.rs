@@ -66,6 +66,23 @@ impl<M: Model> Estimator<M> {
 
     /// Process one sample.
     ///
+    /// ```
+    /// use model_core::models::lugre::{LuGre, SEED000_AVERAGE};
+    /// use model_core::rate::RateParams;
+    /// use model_core::{Estimator, Flags, Model, Sample};
+    ///
+    /// let dt = 1e-4;
+    /// let est = Estimator::new(LuGre::from_params(&SEED000_AVERAGE, dt)?, RateParams::backward(dt)?)?;
+    /// let mut state = est.state();
+    /// let out = est.step(&mut state, Sample::new(1.5));
+    /// assert!(out.flags.ok() && out.y.is_finite());
+    /// // A NaN sample changes nothing and holds the output.
+    /// let held = est.step(&mut state, Sample::new(f32::NAN));
+    /// assert_eq!(held.y, out.y);
+    /// assert!(held.flags.contains(Flags::NON_FINITE_INPUT));
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
+    ///
     /// Non-finite rule: a sample whose `x`, `u`, `dx` or `ddx` is NaN or ±Inf is
     /// ignored — no state changes, the output is the last valid output (0 before the
     /// first), and [`Flags::NON_FINITE_INPUT`] is set. A finite sample that drives the

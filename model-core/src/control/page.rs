@@ -102,6 +102,26 @@ impl core::fmt::Display for PageError {
 impl core::error::Error for PageError {}
 
 /// Everything a page holds.
+///
+/// # Examples
+///
+/// ```
+/// use model_core::control::{ConfigImage, ControlConfig, RateSpec};
+/// use model_core::models::bouc_wen::{BoucWen, SEED000_AVERAGE};
+///
+/// let dt = 5e-5;
+/// let control = ControlConfig { kp_t: 0.2, ..ControlConfig::defaults(dt) }.validate()?;
+/// let rate = RateSpec::Kalman { q: 1e6, r: 1e-6 };
+/// let image = ConfigImage::new("bouc_wen", &SEED000_AVERAGE, rate, control)?;
+/// let page = image.encode(); // the bytes of the flash page
+/// let back = ConfigImage::decode(&page)?;
+/// assert_eq!(back, image);
+/// // The firmware builds its model and rate estimator from the page.
+/// let model: BoucWen = back.model()?;
+/// let rate = back.rate.build(dt)?;
+/// # let _ = (model, rate);
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ConfigImage {
     id: [u8; ID_BYTES],

@@ -179,6 +179,28 @@ impl<S: Default> ControlState<S> {
 }
 
 /// Immutable part: the torque model with its rate estimator.
+///
+/// # Examples
+///
+/// ```
+/// use model_core::control::{ControlConfig, ControlInput, ControlStep};
+/// use model_core::models::algebraic::{Algebraic, SEED000_AVERAGE};
+/// use model_core::rate::RateParams;
+/// use model_core::Model;
+///
+/// let dt = 1e-4; // 10 kHz ADC interrupt
+/// let cfg = ControlConfig { kp_t: 0.2, ..ControlConfig::defaults(dt) }.validate()?;
+/// let model = Algebraic::from_params(&SEED000_AVERAGE, dt)?;
+/// let step = ControlStep::new(model, RateParams::filtered(dt, 200.0)?)?;
+/// let mut state = step.state();
+/// // The slow supervisor pass (about 1 kHz, lower priority); NaN: no temperature sensor.
+/// step.slow(&cfg, &mut state, f32::NAN);
+/// // One ADC interrupt: Hall and coil-current counts at mid-scale, 24 V, 1 N·m reference.
+/// let out = step.step(&cfg, &mut state, ControlInput::new(2048, 2047, 24.0, 1.0));
+/// assert!(out.duty.is_finite() && out.b.is_finite() && out.torque_est.is_finite());
+/// assert!(!out.pwm_enable, "the bridge stays off while the ADC offsets are calibrated");
+/// # Ok::<(), model_core::ParamError>(())
+/// ```
 #[derive(Clone, Copy, Debug)]
 pub struct ControlStep<M: Model> {
     pub est: Estimator<M>,

@@ -43,6 +43,20 @@ pub type Registered = Arctan;
 
 impl Arctan {
     /// Finite values; `cb_a, fy_a, k_a, xd0_a ≥ 0`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::arctan::{Arctan, Params};
+    /// use model_core::{Kin, Model};
+    ///
+    /// let p = Params { f0: [20.0, 5.0], cb: [900.0, 400.0], fy: [150.0, 700.0], k: [60.0, 10.0], xd0: [0.01, 0.005] };
+    /// let model = Arctan::new(p, 1e-3)?;
+    /// // 5 cm/s, accelerating, at 1 A.
+    /// let force = model.step(&mut (), &Kin::new(0.0, 0.05, 1.0, 1.0));
+    /// assert!(force.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(p: Params, dt: f32) -> Result<Self, ParamError> {
         let dt = time_step(dt)?;
         p.validate()?;

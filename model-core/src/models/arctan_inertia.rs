@@ -35,6 +35,19 @@ pub type Registered = ArctanInertia;
 
 impl ArctanInertia {
     /// The bounds of [`Arctan::new`](crate::models::arctan::Arctan::new), and a finite `m`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::arctan_inertia::{ArctanInertia, Params};
+    /// use model_core::{Kin, Model};
+    ///
+    /// let p = Params { f0: [20.0, 5.0], cb: [900.0, 400.0], fy: [150.0, 700.0], k: [60.0, 10.0], xd0: [0.01, 0.005] };
+    /// let model = ArctanInertia::new(p, 0.5, 1e-3)?;
+    /// let force = model.step(&mut (), &Kin::new(0.0, 0.05, 1.0, 1.0));
+    /// assert!(force.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(p: Params, m: f32, dt: f32) -> Result<Self, ParamError> {
         let dt = time_step(dt)?;
         p.validate()?;

@@ -32,12 +32,33 @@ use crate::{Kin, Model, ParamError};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bingham {
     /// `[fc0, fc1, fc2, fc3]`: friction force polynomial in u, N per uᵏ (eq. 13).
-    pub fc: [f32; 4],
+    fc: [f32; 4],
     /// `[c0_0, …, c0_4]`: damping polynomial in u, N·s per unit x per uᵏ (eq. 14).
-    pub c0: [f32; 5],
+    c0: [f32; 5],
     /// f0: accumulator force offset, N.
-    pub f0: f32,
+    f0: f32,
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl Bingham {
+    /// `[fc0, fc1, fc2, fc3]`: friction force polynomial in u, N per uᵏ (eq. 13).
+    #[inline]
+    pub fn fc(&self) -> &[f32; 4] {
+        &self.fc
+    }
+
+    /// `[c0_0, …, c0_4]`: damping polynomial in u, N·s per unit x per uᵏ (eq. 14).
+    #[inline]
+    pub fn c0(&self) -> &[f32; 5] {
+        &self.c0
+    }
+
+    /// f0: accumulator force offset, N.
+    #[inline]
+    pub fn f0(&self) -> f32 {
+        self.f0
+    }
 }
 
 /// The Bingham model has no state.
@@ -50,6 +71,20 @@ pub const SEED003: ([f32; 4], [f32; 5], f32) =
 
 impl Bingham {
     /// Every coefficient finite; `fc0 ≥ 0` and `c0_0 ≥ 0` (a passive damper at zero command).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::bingham::{Bingham, SEED003};
+    /// use model_core::{Kin, Model};
+    ///
+    /// let (fc, c0, f0) = SEED003;
+    /// let model = Bingham::new(fc, c0, f0, 1e-3)?;
+    /// // 10 mm/s at 0.5 A.
+    /// let force = model.step(&mut (), &Kin::new(0.0, 10.0, 0.0, 0.5));
+    /// assert!(force.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(fc: [f32; 4], c0: [f32; 5], f0: f32, dt: f32) -> Result<Self, ParamError> {
         let dt = time_step(dt)?;
         for (name, v) in FC_NAMES.iter().zip(fc.iter()) {

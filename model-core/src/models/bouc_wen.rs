@@ -117,21 +117,21 @@ enum Exponent {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoucWen {
     /// Scale α of z (N·m or N per unit z).
-    pub alpha: f32,
+    alpha: f32,
     /// β, multiplies `ẋ·|z|ⁿ`.
-    pub beta: f32,
+    beta: f32,
     /// γ ≥ 0, multiplies `|ẋ|·z·|z|ⁿ⁻¹`.
-    pub gamma: f32,
+    gamma: f32,
     /// δ (Wen's A), the slope dz/dx at z = 0.
-    pub delta: f32,
+    delta: f32,
     /// Exponent n ∈ [1, 10].
-    pub n: f32,
+    n: f32,
     /// Viscous coefficient c (c₀).
-    pub c: f32,
+    c: f32,
     /// Stiffness k (k₀).
-    pub k: f32,
+    k: f32,
     /// Initial displacement x₀ of the spring (0 for the clutch).
-    pub x0: f32,
+    x0: f32,
     dt: f32,
     /// Bound z* of |z|.
     z_max: f32,
@@ -152,6 +152,57 @@ pub struct BoucWen {
     k_x0: f32,
 }
 
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl BoucWen {
+    /// Scale α of z (N·m or N per unit z).
+    #[inline]
+    pub fn alpha(&self) -> f32 {
+        self.alpha
+    }
+
+    /// β, multiplies `ẋ·|z|ⁿ`.
+    #[inline]
+    pub fn beta(&self) -> f32 {
+        self.beta
+    }
+
+    /// γ ≥ 0, multiplies `|ẋ|·z·|z|ⁿ⁻¹`.
+    #[inline]
+    pub fn gamma(&self) -> f32 {
+        self.gamma
+    }
+
+    /// δ (Wen's A), the slope dz/dx at z = 0.
+    #[inline]
+    pub fn delta(&self) -> f32 {
+        self.delta
+    }
+
+    /// Exponent n ∈ [1, 10].
+    #[inline]
+    pub fn n(&self) -> f32 {
+        self.n
+    }
+
+    /// Viscous coefficient c (c₀).
+    #[inline]
+    pub fn c(&self) -> f32 {
+        self.c
+    }
+
+    /// Stiffness k (k₀).
+    #[inline]
+    pub fn k(&self) -> f32 {
+        self.k
+    }
+
+    /// Initial displacement x₀ of the spring (0 for the clutch).
+    #[inline]
+    pub fn x0(&self) -> f32 {
+        self.x0
+    }
+}
+
 /// State: the hysteretic variable and the previous input sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct State {
@@ -169,6 +220,27 @@ pub type Registered = BoucWen;
 
 impl BoucWen {
     /// Build from the paper's parameters (seed 000/001 naming, see the module doc).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::bouc_wen::{BoucWen, SEED000_AVERAGE};
+    /// use model_core::rate::RateParams;
+    /// use model_core::{Estimator, Sample};
+    ///
+    /// let dt = 1e-4; // 10 kHz, as the firmware runs it
+    /// let [alpha, beta, gamma, delta, n, c, k, x0] = SEED000_AVERAGE;
+    /// let model = BoucWen::new(alpha, beta, gamma, delta, n, c, k, x0, dt)?;
+    /// // The firmware's path: raw samples in, the estimator supplies the rates.
+    /// let est = Estimator::new(model, RateParams::kalman(dt, 1e6, 1e-6)?)?;
+    /// let mut state = est.state();
+    /// for i in 0..200 {
+    ///     let b = 1.5 + 1.5 * (core::f32::consts::TAU * 5.0 * i as f32 * dt).sin();
+    ///     let out = est.step(&mut state, Sample::new(b));
+    ///     assert!(out.flags.ok() && out.y.is_finite());
+    /// }
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         alpha: f32,
@@ -462,6 +534,23 @@ fn region_n2(v0: f32, l: f32, p: f32, q: f32) -> Leg {
     let v = s * (v0 - s * t) / (s - v0 * t);
     Leg::Done(if v > 0.0 { v } else { 0.0 })
 }
+
+/// Seed 000 (Yang & Kermani 2023) Table 3, the five per-frequency fits and their average
+/// (clutch input B, T in N·m), in [`Model::from_params`] order
+/// `alpha, beta, gamma, delta, n, c, k, x0`. Table 3's β and γ are read in Wen's naming
+/// (its β is this γ and its γ this β; see [`BoucWen::new_wen_naming`]), `n = 1`, `x₀ = 0`.
+/// Read as printed, the δ < 0 sets fall outside the bounded class [`BoucWen::new`] accepts.
+pub const SEED000_TABLE3: [(&str, [f32; 8]); 6] = [
+    ("1 Hz", [2.472, 0.062, 1.000, -2.083, 1.0, -0.145, 6.518, 0.0]),
+    ("3 Hz", [2.793, 0.038, 1.000, -1.816, 1.0, -0.084, 6.072, 0.0]),
+    ("5 Hz", [2.441, 0.438, 1.000, -1.523, 1.0, -0.064, 5.826, 0.0]),
+    ("7 Hz", [0.641, 0.847, 1.000, 0.488, 1.0, -0.047, 5.294, 0.0]),
+    ("9 Hz", [2.464, 0.615, 1.000, -2.495, 1.0, -0.045, 5.593, 0.0]),
+    ("average", SEED000_AVERAGE),
+];
+
+/// The average row of [`SEED000_TABLE3`] (Wen's naming, flat order).
+pub const SEED000_AVERAGE: [f32; 8] = [2.162, 0.400, 1.000, -1.486, 1.0, -0.077, 5.861, 0.0];
 
 impl Model for BoucWen {
     type State = State;

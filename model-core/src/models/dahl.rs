@@ -62,9 +62,18 @@ pub struct Params {
 /// Validated coefficients of the modified Dahl model at one time step.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Dahl {
-    pub p: Params,
+    p: Params,
     dt: f32,
     filter: CommandFilter,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl Dahl {
+    /// The parameters as given.
+    #[inline]
+    pub fn params(&self) -> &Params {
+        &self.p
+    }
 }
 
 /// State of [`Dahl`].
@@ -100,6 +109,22 @@ pub const DYKE_PLAUSIBLE: Params =
 
 impl Dahl {
     /// Validate (bounds in [`Params`]).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::dahl::{Dahl, Params};
+    /// use model_core::{Kin, Model};
+    ///
+    /// let p = Params { c0s: 50.0, c0d: 20.0, fds: 300.0, fdu: 200.0, k0: 5.0, sigma: 10.0, f0: 2.0, eta: 30.0 };
+    /// let model = Dahl::new(p, 1e-3)?;
+    /// let mut state = model.initial_state(&Kin::new(0.0, 0.0, 0.0, 1.0));
+    /// // The first step sets the rest state, the next integrates.
+    /// let _ = model.step(&mut state, &Kin::new(0.0, 0.0, 0.0, 1.0));
+    /// let force = model.step(&mut state, &Kin::new(0.01, 10.0, 0.0, 1.0));
+    /// assert!(force.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(p: Params, dt: f32) -> Result<Self, ParamError> {
         let big = 1e12;
         let dt = time_step(dt)?;

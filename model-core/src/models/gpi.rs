@@ -90,21 +90,21 @@ impl EnvelopeCoeffs {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Gpi<const N: usize> {
     /// Linear gain p₀ (G[x] = p₀·x).
-    pub p0: f32,
+    p0: f32,
     /// Initial condition M₀ of every operator.
-    pub m0: f32,
+    m0: f32,
     /// Density scale δ₁ ≥ 0.
-    pub delta1: f32,
+    delta1: f32,
     /// Density decay δ₂ ≥ 0.
-    pub delta2: f32,
+    delta2: f32,
     /// Loading (rising) envelope α_R.
-    pub rising: EnvelopeCoeffs,
+    rising: EnvelopeCoeffs,
     /// Unloading (falling) envelope α_L.
-    pub falling: EnvelopeCoeffs,
+    falling: EnvelopeCoeffs,
     /// Input range the radii span.
-    pub x_min: f32,
-    pub x_max: f32,
-    pub envelope: Envelope,
+    x_min: f32,
+    x_max: f32,
+    envelope: Envelope,
     /// Radii rᵢ (unit of x), ascending from 0 to x_max − x_min.
     r: [f32; N],
     /// Weights pᵢ = δ₁·exp(−δ₂·rᵢ).
@@ -112,6 +112,63 @@ pub struct Gpi<const N: usize> {
     /// 1/(2c) of the Gaussian envelopes (0 otherwise).
     inv2c: [f32; 2],
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl<const N: usize> Gpi<N> {
+    /// Linear gain p₀ (G[x] = p₀·x).
+    #[inline]
+    pub fn p0(&self) -> f32 {
+        self.p0
+    }
+
+    /// Initial condition M₀ of every operator.
+    #[inline]
+    pub fn m0(&self) -> f32 {
+        self.m0
+    }
+
+    /// Density scale δ₁ ≥ 0.
+    #[inline]
+    pub fn delta1(&self) -> f32 {
+        self.delta1
+    }
+
+    /// Density decay δ₂ ≥ 0.
+    #[inline]
+    pub fn delta2(&self) -> f32 {
+        self.delta2
+    }
+
+    /// Loading (rising) envelope α_R.
+    #[inline]
+    pub fn rising(&self) -> EnvelopeCoeffs {
+        self.rising
+    }
+
+    /// Unloading (falling) envelope α_L.
+    #[inline]
+    pub fn falling(&self) -> EnvelopeCoeffs {
+        self.falling
+    }
+
+    /// Input range the radii span.
+    #[inline]
+    pub fn x_min(&self) -> f32 {
+        self.x_min
+    }
+
+    /// Upper end of the input range the radii span.
+    #[inline]
+    pub fn x_max(&self) -> f32 {
+        self.x_max
+    }
+
+    /// The envelope family of α_R and α_L.
+    #[inline]
+    pub fn envelope(&self) -> Envelope {
+        self.envelope
+    }
 }
 
 /// Outputs of the `N` generalized play operators (unit of x).
@@ -123,6 +180,21 @@ pub type Registered = Gpi<10>;
 impl<const N: usize> Gpi<N> {
     /// Paper form. `δ₁, δ₂ ≥ 0`, `x_min < x_max`, every coefficient finite, `c ≠ 0`
     /// for Gaussian envelopes, `1 ≤ N ≤ 64`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::gpi::{Envelope, EnvelopeCoeffs, Gpi};
+    /// use model_core::{Kin, Model};
+    ///
+    /// // Seed 004 Table A9 (tanh envelopes, 10 operators), signs as printed.
+    /// let (rising, falling) = (EnvelopeCoeffs::new(1.2251, 0.5371, 0.2911), EnvelopeCoeffs::new(2.1285, 1.9745, 1.7202));
+    /// let model = Gpi::<10>::new(Envelope::Tanh, 0.4084, 0.1185, 0.1872, 0.1920, rising, falling, 0.0, 1.0, 1e-3)?;
+    /// let mut state = model.initial_state(&Kin::new(0.2, 0.0, 0.0, 0.0));
+    /// let y = model.step(&mut state, &Kin::new(0.3, 0.0, 0.0, 0.0));
+    /// assert!(y.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         envelope: Envelope,

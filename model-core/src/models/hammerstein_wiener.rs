@@ -115,17 +115,56 @@ pub fn schur_stable(a: &[f32; 5]) -> bool {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HammersteinWiener<const NH: usize, const NW: usize> {
     /// Input nonlinearity H (eq. 15).
-    pub h: SigmoidNet<NH>,
+    h: SigmoidNet<NH>,
     /// Numerator b₀, b₁, b₂ (two zeros), acting on x(t−1), x(t−2), x(t−3).
-    pub lin_b: [f32; 3],
+    lin_b: [f32; 3],
     /// Denominator f₁ … f₅ of `1 + f₁q⁻¹ + … + f₅q⁻⁵` (five poles).
-    pub lin_f: [f32; 5],
+    lin_f: [f32; 5],
     /// Output nonlinearity W (eq. 17).
-    pub w: SigmoidNet<NW>,
+    w: SigmoidNet<NW>,
     /// Range the internal v is clamped to.
-    pub v_min: f32,
-    pub v_max: f32,
+    v_min: f32,
+    v_max: f32,
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl<const NH: usize, const NW: usize> HammersteinWiener<NH, NW> {
+    /// Input nonlinearity H (eq. 15).
+    #[inline]
+    pub fn h(&self) -> &SigmoidNet<NH> {
+        &self.h
+    }
+
+    /// Numerator b₀, b₁, b₂ (two zeros), acting on x(t−1), x(t−2), x(t−3).
+    #[inline]
+    pub fn lin_b(&self) -> &[f32; 3] {
+        &self.lin_b
+    }
+
+    /// Denominator f₁ … f₅ of `1 + f₁q⁻¹ + … + f₅q⁻⁵` (five poles).
+    #[inline]
+    pub fn lin_f(&self) -> &[f32; 5] {
+        &self.lin_f
+    }
+
+    /// Output nonlinearity W (eq. 17).
+    #[inline]
+    pub fn w(&self) -> &SigmoidNet<NW> {
+        &self.w
+    }
+
+    /// Range the internal v is clamped to.
+    #[inline]
+    pub fn v_min(&self) -> f32 {
+        self.v_min
+    }
+
+    /// Upper end of the range the internal v is clamped to.
+    #[inline]
+    pub fn v_max(&self) -> f32 {
+        self.v_max
+    }
 }
 
 /// Past values of the linear block: `xs = [x(t−1), x(t−2), x(t−3)]`, `vs = [v(t−1), …, v(t−5)]`.
@@ -153,6 +192,22 @@ impl<const NH: usize, const NW: usize> HammersteinWiener<NH, NW> {
     const N_W_B: BlockName = BlockName::new("w_b", NW);
 
     /// Validate and build (see the module doc for the checks).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::hammerstein_wiener::{HammersteinWiener, SigmoidNet};
+    /// use model_core::{Kin, Model};
+    ///
+    /// let h = SigmoidNet { a: [2.0, -1.0], w: [1.5, 0.5], b: [0.1, -0.2], lin: 0.3, d: 0.05 };
+    /// let w = SigmoidNet { a: [1.0], w: [0.5], b: [0.0], lin: 1.0, d: 0.0 };
+    /// // Two zeros, five poles at 0.5 (stable), v clamped to ±10.
+    /// let model = HammersteinWiener::new(h, [0.5, 0.2, 0.1], [-2.5, 2.5, -1.25, 0.3125, -0.03125], w, -10.0, 10.0, 1e-3)?;
+    /// let mut state = model.initial_state(&Kin::new(1.0, 0.0, 0.0, 0.0));
+    /// let y = model.step(&mut state, &Kin::new(1.1, 0.0, 0.0, 0.0));
+    /// assert!(y.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(
         h: SigmoidNet<NH>,
         lin_b: [f32; 3],

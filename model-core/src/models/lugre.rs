@@ -39,17 +39,17 @@ use crate::{Finite, Kin, Model, ParamError};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LuGre {
     /// α > 0, per unit B.
-    pub alpha: f32,
+    alpha: f32,
     /// β, N·m (scale of the hysteretic torque, β/α per unit z).
-    pub beta: f32,
+    beta: f32,
     /// ε, N·m·s (damping of ż).
-    pub epsilon: f32,
+    epsilon: f32,
     /// Viscous coefficient c, N·m·s per unit B.
-    pub c: f32,
+    c: f32,
     /// Stiffness k, N·m per unit B.
-    pub k: f32,
+    k: f32,
     /// Residual torque T₀, N·m.
-    pub t0: f32,
+    t0: f32,
     dt: f32,
     beta_a: f32,
     eps_a: f32,
@@ -57,6 +57,45 @@ pub struct LuGre {
     c_eps: f32,
     /// Weight of |B̈| in the short-step test: `α·dt²·FAST_Y/TURN_EPS`.
     turn_k: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl LuGre {
+    /// α > 0, per unit B.
+    #[inline]
+    pub fn alpha(&self) -> f32 {
+        self.alpha
+    }
+
+    /// β, N·m (scale of the hysteretic torque, β/α per unit z).
+    #[inline]
+    pub fn beta(&self) -> f32 {
+        self.beta
+    }
+
+    /// ε, N·m·s (damping of ż).
+    #[inline]
+    pub fn epsilon(&self) -> f32 {
+        self.epsilon
+    }
+
+    /// Viscous coefficient c, N·m·s per unit B.
+    #[inline]
+    pub fn c(&self) -> f32 {
+        self.c
+    }
+
+    /// Stiffness k, N·m per unit B.
+    #[inline]
+    pub fn k(&self) -> f32 {
+        self.k
+    }
+
+    /// Residual torque T₀, N·m.
+    #[inline]
+    pub fn t0(&self) -> f32 {
+        self.t0
+    }
 }
 
 /// Largest `α·|ΔB|` (plus the reversal term) handled by the short-step series.
@@ -84,6 +123,29 @@ impl Finite for State {
 pub type Registered = LuGre;
 
 impl LuGre {
+    /// Validate eq. 7–8's coefficients: `0 < α ≤ 1e6`, the others finite, `β/α` and `ε/α`
+    /// finite.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::lugre::{LuGre, SEED000_AVERAGE};
+    /// use model_core::rate::RateParams;
+    /// use model_core::{Estimator, Model, Sample};
+    ///
+    /// let dt = 1e-4;
+    /// let [alpha, beta, epsilon, c, k, t0] = SEED000_AVERAGE;
+    /// let model = LuGre::new(alpha, beta, epsilon, c, k, t0, dt)?;
+    /// assert_eq!(model.dt(), dt);
+    /// let est = Estimator::new(model, RateParams::filtered(dt, 200.0)?)?;
+    /// let mut state = est.state();
+    /// for i in 0..200 {
+    ///     let b = 1.5 + 1.5 * (core::f32::consts::TAU * 5.0 * i as f32 * dt).sin();
+    ///     let out = est.step(&mut state, Sample::new(b));
+    ///     assert!(out.flags.ok() && out.y.is_finite());
+    /// }
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(alpha: f32, beta: f32, epsilon: f32, c: f32, k: f32, t0: f32, dt: f32) -> Result<Self, ParamError> {
         let alpha = check("alpha", alpha, f32::MIN_POSITIVE, 1.0e6)?;
         let beta = finite("beta", beta)?;
@@ -124,6 +186,20 @@ impl LuGre {
         clamp(z1, -1.0, 1.0)
     }
 }
+
+/// Seed 000 (Yang & Kermani 2023) Table 4, the five per-frequency fits and their average
+/// (clutch input B, T in N·m), in [`Model::from_params`] order `alpha, beta, epsilon, c, k, t0`.
+pub const SEED000_TABLE4: [(&str, [f32; 6]); 6] = [
+    ("1 Hz", [5.315, 6.251, 0.042, -0.443, 4.441, 5.508]),
+    ("3 Hz", [3.590, 6.456, 0.017, -0.144, 4.947, 5.326]),
+    ("5 Hz", [5.695, 5.831, 0.000, -0.105, 3.469, 5.146]),
+    ("7 Hz", [3.062, 5.783, -0.030, -0.026, 4.859, 5.036]),
+    ("9 Hz", [3.899, 4.534, -0.014, -0.038, 3.769, 5.110]),
+    ("average", SEED000_AVERAGE),
+];
+
+/// The average row of [`SEED000_TABLE4`].
+pub const SEED000_AVERAGE: [f32; 6] = [4.312, 5.771, 0.003, -0.151, 4.297, 5.225];
 
 impl Model for LuGre {
     type State = State;

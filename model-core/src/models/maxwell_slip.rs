@@ -31,16 +31,43 @@ const F_BLOCKS: [&str; MAX_OPERATORS + 1] = block_names!("f");
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MaxwellSlip<const N: usize> {
     /// Output offset w₀ (output units).
-    pub w0: f32,
+    w0: f32,
     /// Spring stiffnesses kᵢ > 0 (output units per unit x).
-    pub k: [f32; N],
+    k: [f32; N],
     /// Breakaway forces fᵢ ≥ 0 (output units).
-    pub f: [f32; N],
+    f: [f32; N],
     /// Linear term k₀ (output units per unit x); 0 in seed 004.
-    pub k0: f32,
+    k0: f32,
     /// Deflection limits fᵢ/kᵢ (unit of x).
     lim: [f32; N],
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl<const N: usize> MaxwellSlip<N> {
+    /// Output offset w₀ (output units).
+    #[inline]
+    pub fn w0(&self) -> f32 {
+        self.w0
+    }
+
+    /// Spring stiffnesses kᵢ > 0 (output units per unit x).
+    #[inline]
+    pub fn k(&self) -> &[f32; N] {
+        &self.k
+    }
+
+    /// Breakaway forces fᵢ ≥ 0 (output units).
+    #[inline]
+    pub fn f(&self) -> &[f32; N] {
+        &self.f
+    }
+
+    /// Linear term k₀ (output units per unit x); 0 in seed 004.
+    #[inline]
+    pub fn k0(&self) -> f32 {
+        self.k0
+    }
 }
 
 /// Previous input and the spring deflections `dᵢ = x − x_bᵢ` (unit of x).
@@ -68,6 +95,20 @@ pub type Registered = MaxwellSlip<10>;
 impl<const N: usize> MaxwellSlip<N> {
     /// `kᵢ > 0`, `fᵢ ≥ 0` (seed 004 Table A15 bounds 0.01…10 and 0…10), `w₀`, `k₀` finite,
     /// `1 ≤ N ≤ 64`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::maxwell_slip::MaxwellSlip;
+    /// use model_core::{Kin, Model};
+    ///
+    /// // Two elasto-slide elements (stiffness k, slip force f), offset w₀, linear spring k₀.
+    /// let model = MaxwellSlip::new(0.1, [1.0, 10.0], [0.5, 0.2], 0.3, 1e-3)?;
+    /// let mut state = model.initial_state(&Kin::new(0.0, 0.0, 0.0, 0.0));
+    /// let y = model.step(&mut state, &Kin::new(0.04, 0.0, 0.0, 0.0));
+    /// assert!(y.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(w0: f32, k: [f32; N], f: [f32; N], k0: f32, dt: f32) -> Result<Self, ParamError> {
         operator_count(N)?;
         let mut lim = [0.0; N];

@@ -48,20 +48,89 @@ const U_LIM: f32 = 1.0e6;
 /// Coefficients of the NARX model with `H` hidden sigmoid units.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Narx<const H: usize> {
-    pub u_mean: f32,
-    pub u_scale: f32,
-    pub y_mean: f32,
-    pub y_scale: f32,
+    u_mean: f32,
+    u_scale: f32,
+    y_mean: f32,
+    y_scale: f32,
     /// W₁…W₇ of eq. 19 (on ŷ(t−1), û(t), …, û(t−5)).
-    pub lin: [f32; 7],
+    lin: [f32; 7],
     /// Hidden-layer weights, one row of 7 per unit.
-    pub hid_w: [[f32; 7]; H],
-    pub hid_b: [f32; H],
-    pub out_a: [f32; H],
-    pub offset: f32,
-    pub y_min: f32,
-    pub y_max: f32,
+    hid_w: [[f32; 7]; H],
+    hid_b: [f32; H],
+    out_a: [f32; H],
+    offset: f32,
+    y_min: f32,
+    y_max: f32,
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl<const H: usize> Narx<H> {
+    /// Mean of the input subtracted before scaling.
+    #[inline]
+    pub fn u_mean(&self) -> f32 {
+        self.u_mean
+    }
+
+    /// Scale of the input: `û = (u − u_mean)/u_scale`.
+    #[inline]
+    pub fn u_scale(&self) -> f32 {
+        self.u_scale
+    }
+
+    /// Mean of the output: `ŷ = (y − y_mean)/y_scale`.
+    #[inline]
+    pub fn y_mean(&self) -> f32 {
+        self.y_mean
+    }
+
+    /// Scale of the normalised output.
+    #[inline]
+    pub fn y_scale(&self) -> f32 {
+        self.y_scale
+    }
+
+    /// W₁…W₇ of eq. 19 (on ŷ(t−1), û(t), …, û(t−5)).
+    #[inline]
+    pub fn lin(&self) -> &[f32; 7] {
+        &self.lin
+    }
+
+    /// Hidden-layer weights, one row of 7 per unit.
+    #[inline]
+    pub fn hid_w(&self) -> &[[f32; 7]; H] {
+        &self.hid_w
+    }
+
+    /// Hidden-layer biases, one per unit.
+    #[inline]
+    pub fn hid_b(&self) -> &[f32; H] {
+        &self.hid_b
+    }
+
+    /// Output weights, one per hidden unit.
+    #[inline]
+    pub fn out_a(&self) -> &[f32; H] {
+        &self.out_a
+    }
+
+    /// Output offset of the network (normalised units).
+    #[inline]
+    pub fn offset(&self) -> f32 {
+        self.offset
+    }
+
+    /// Lower clamp of the output y.
+    #[inline]
+    pub fn y_min(&self) -> f32 {
+        self.y_min
+    }
+
+    /// Upper clamp of the output y.
+    #[inline]
+    pub fn y_max(&self) -> f32 {
+        self.y_max
+    }
 }
 
 /// Past inputs `u(t−1) … u(t−5)` (raw units) and the last output `y(t−1)`.
@@ -91,6 +160,28 @@ impl<const H: usize> Narx<H> {
     const N_OUT_A: BlockName = BlockName::new("out_a", H);
 
     /// Validate and build (bounds in the module doc).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::narx::Narx;
+    /// use model_core::{Kin, Model};
+    ///
+    /// let model = Narx::<2>::new(
+    ///     (1.0, 2.0, 0.5, 4.0),                                                           // u_mean, u_scale, y_mean, y_scale
+    ///     [0.6, 0.3, -0.2, 0.1, 0.05, -0.05, 0.02],                                        // linear part
+    ///     [[0.1, 0.2, 0.3, -0.1, 0.0, 0.5, -0.4], [-0.3, 0.1, 0.0, 0.2, 0.2, -0.1, 0.3]], // hidden weights
+    ///     [0.1, -0.2],                                                                     // hidden biases
+    ///     [1.5, -0.7],                                                                     // output weights
+    ///     0.05,                                                                            // offset
+    ///     (-100.0, 100.0),                                                                 // output clamp
+    ///     1e-3,
+    /// )?;
+    /// let mut state = model.initial_state(&Kin::new(1.0, 0.0, 0.0, 0.0));
+    /// let y = model.step(&mut state, &Kin::new(1.2, 0.0, 0.0, 0.0));
+    /// assert!(y.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         (u_mean, u_scale, y_mean, y_scale): (f32, f32, f32, f32),

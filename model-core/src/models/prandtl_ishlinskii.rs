@@ -39,14 +39,41 @@ pub fn play(x: f32, r: f32, prev: f32) -> f32 {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PrandtlIshlinskii<const N: usize> {
     /// Linear (non-hysteretic) gain p₀ ≥ 0, output units per unit x.
-    pub p0: f32,
+    p0: f32,
     /// Initial condition M₀ of every play operator (eq. 11), unit of x.
-    pub m0: f32,
+    m0: f32,
     /// Radii rᵢ ≥ 0 (any order, repeats allowed), unit of x.
-    pub r: [f32; N],
+    r: [f32; N],
     /// Weights pᵢ ≥ 0, output units per unit x.
-    pub p: [f32; N],
+    p: [f32; N],
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl<const N: usize> PrandtlIshlinskii<N> {
+    /// Linear (non-hysteretic) gain p₀ ≥ 0, output units per unit x.
+    #[inline]
+    pub fn p0(&self) -> f32 {
+        self.p0
+    }
+
+    /// Initial condition M₀ of every play operator (eq. 11), unit of x.
+    #[inline]
+    pub fn m0(&self) -> f32 {
+        self.m0
+    }
+
+    /// Radii rᵢ ≥ 0 (any order, repeats allowed), unit of x.
+    #[inline]
+    pub fn r(&self) -> &[f32; N] {
+        &self.r
+    }
+
+    /// Weights pᵢ ≥ 0, output units per unit x.
+    #[inline]
+    pub fn p(&self) -> &[f32; N] {
+        &self.p
+    }
 }
 
 /// Outputs of the `N` play operators (unit of x).
@@ -58,6 +85,24 @@ pub type Registered = PrandtlIshlinskii<10>;
 impl<const N: usize> PrandtlIshlinskii<N> {
     /// Paper form: `p₀ ≥ 0`, `M₀` finite, radii `rᵢ ≥ 0`, weights `pᵢ ≥ 0` (seed 004's
     /// bounds, Tables A7–A8). `1 ≤ N ≤ 64`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::prandtl_ishlinskii::PrandtlIshlinskii;
+    /// use model_core::{Kin, Model};
+    ///
+    /// let model = PrandtlIshlinskii::new(0.5, 0.0, [0.0, 0.1, 0.2], [0.3, 0.2, 0.1], 1e-3)?;
+    /// let mut state = model.initial_state(&Kin::new(0.0, 0.0, 0.0, 0.0));
+    /// let y = model.step(&mut state, &Kin::new(0.3, 0.0, 0.0, 0.0));
+    /// // Every play operator follows x once x leaves its band: p₀·x + Σ pᵢ·(x − rᵢ).
+    /// assert!((y - (0.5 * 0.3 + 0.3 * 0.3 + 0.2 * 0.2 + 0.1 * 0.1)).abs() < 1e-6);
+    /// // The inverse undoes it.
+    /// let inv = model.inverse()?;
+    /// let mut inv_state = inv.state_from(&state);
+    /// assert!(inv.step(&mut inv_state, y).is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(p0: f32, m0: f32, r: [f32; N], p: [f32; N], dt: f32) -> Result<Self, ParamError> {
         operator_count(N)?;
         for v in r {
@@ -142,17 +187,38 @@ impl<const N: usize> Model for PrandtlIshlinskii<N> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Inverse<const N: usize> {
     /// p̂₀ = 1/p₀.
-    pub q0: f32,
+    q0: f32,
     /// Inverse radii r̂ⱼ, ascending (output units).
-    pub r: [f32; N],
+    r: [f32; N],
     /// Inverse weights p̂ⱼ ≤ 0.
-    pub q: [f32; N],
+    q: [f32; N],
     /// Forward operator index of sorted position j.
     order: [usize; N],
     /// Forward partial sums Pⱼ (sorted order).
     partial: [f32; N],
     /// Forward weights in sorted order.
     p_sorted: [f32; N],
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl<const N: usize> Inverse<N> {
+    /// p̂₀ = 1/p₀.
+    #[inline]
+    pub fn q0(&self) -> f32 {
+        self.q0
+    }
+
+    /// Inverse radii r̂ⱼ, ascending (output units).
+    #[inline]
+    pub fn r(&self) -> &[f32; N] {
+        &self.r
+    }
+
+    /// Inverse weights p̂ⱼ ≤ 0.
+    #[inline]
+    pub fn q(&self) -> &[f32; N] {
+        &self.q
+    }
 }
 
 /// Play operator states of the inverse model (output units).

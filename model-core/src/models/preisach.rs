@@ -83,26 +83,83 @@ fn cauchy(k: f64, mu: f64, sigma: f64) -> f64 {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Preisach<const N: usize> {
     /// σ of p_M(H_M) (> 0, normalised input units).
-    pub sigma_hm: f32,
+    sigma_hm: f32,
     /// μ of p_M(H_M) (normalised input units).
-    pub mu_hm: f32,
+    mu_hm: f32,
     /// σ of p_C(H_C) (> 0).
-    pub sigma_hc: f32,
+    sigma_hc: f32,
     /// μ of p_C(H_C).
-    pub mu_hc: f32,
+    mu_hc: f32,
     /// Output offset y₀ (output units).
-    pub y0: f32,
+    y0: f32,
     /// Output scale s (output units per unit weight); 1 in seed 004.
-    pub scale: f32,
+    scale: f32,
     /// Input range mapped to the normalised 0…1 of the grid (unit of x).
-    pub x_min: f32,
-    pub x_max: f32,
-    pub density: Density,
+    x_min: f32,
+    x_max: f32,
+    density: Density,
     /// Thresholds αᵢ = βᵢ in the unit of x, ascending.
     thresholds: [f32; N],
     /// `cum[i][j] = s·Σ_{l ≤ j} p(αᵢ, β_l)` for `j ≤ i` (output units).
     cum: [[f32; N]; N],
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl<const N: usize> Preisach<N> {
+    /// σ of p_M(H_M) (> 0, normalised input units).
+    #[inline]
+    pub fn sigma_hm(&self) -> f32 {
+        self.sigma_hm
+    }
+
+    /// μ of p_M(H_M) (normalised input units).
+    #[inline]
+    pub fn mu_hm(&self) -> f32 {
+        self.mu_hm
+    }
+
+    /// σ of p_C(H_C) (> 0).
+    #[inline]
+    pub fn sigma_hc(&self) -> f32 {
+        self.sigma_hc
+    }
+
+    /// μ of p_C(H_C).
+    #[inline]
+    pub fn mu_hc(&self) -> f32 {
+        self.mu_hc
+    }
+
+    /// Output offset y₀ (output units).
+    #[inline]
+    pub fn y0(&self) -> f32 {
+        self.y0
+    }
+
+    /// Output scale s (output units per unit weight); 1 in seed 004.
+    #[inline]
+    pub fn scale(&self) -> f32 {
+        self.scale
+    }
+
+    /// Input range mapped to the normalised 0…1 of the grid (unit of x).
+    #[inline]
+    pub fn x_min(&self) -> f32 {
+        self.x_min
+    }
+
+    /// Upper end of the input range mapped to the grid.
+    #[inline]
+    pub fn x_max(&self) -> f32 {
+        self.x_max
+    }
+
+    /// The density family of p_M, p_C.
+    #[inline]
+    pub fn density(&self) -> Density {
+        self.density
+    }
 }
 
 /// Relay states: `on[i]` relays of row `αᵢ` are on, namely those with `β₁ … β_{on[i]}`.
@@ -147,6 +204,20 @@ pub type Registered = Preisach<50>;
 impl<const N: usize> Preisach<N> {
     /// Paper form (Tables A1–A6 order) plus output scale and input range.
     /// `σ_HM, σ_HC > 0`, every value finite, `x_min < x_max`, `1 ≤ N ≤ 255`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::preisach::{Density, Preisach};
+    /// use model_core::{Kin, Model};
+    ///
+    /// // Seed 004 Table A2 (GC), on a 10 × 10 grid over the normalised input 0…1.
+    /// let model = Preisach::<10>::new(Density::GaussCauchy, 3.2352, 11.6040, 0.0232, 0.0001, 0.0837, 1.0, 0.0, 1.0, 1e-3)?;
+    /// let mut state = model.initial_state(&Kin::new(0.0, 0.0, 0.0, 0.0));
+    /// let y = model.step(&mut state, &Kin::new(0.6, 0.0, 0.0, 0.0));
+    /// assert!(y.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         density: Density,

@@ -118,9 +118,13 @@
 //! command sample, and whether the first sample has been seen.
 
 use crate::error::{check, count, finite, time_step};
-use crate::math::{abs, atan, expm1, expm1_small, ln, powf, sin, sqrt, tanh_small as tanh};
+use crate::math::{abs, powf, sqrt};
 use crate::model::write_flat;
 use crate::models::kernels::command_filter::{command, raw_command, CommandFilter};
+use solver::stage_count;
+
+mod flow;
+mod solver;
 use crate::{Finite, Kin, Model, ParamError};
 
 /// Maximum number of flow evaluations in the Newton solve for `Δw`.
@@ -129,16 +133,6 @@ pub const NEWTON_ITERS: usize = 6;
 pub const STAGE_LAMBDA_T: f32 = 1.0;
 /// Most stages per step (bounds the worst-case cost).
 pub const MAX_STAGES: usize = 4;
-
-/// `clamp(⌈λT / STAGE_LAMBDA_T⌉, 1, MAX_STAGES)` (NaN → 1).
-#[inline]
-fn stage_count(lam_t: f32) -> usize {
-    let mut m = 1;
-    while m < MAX_STAGES && m as f32 * STAGE_LAMBDA_T < lam_t {
-        m += 1;
-    }
-    m
-}
 
 /// The 14 parameters of eq. 3–7 in the paper's form (seed 001 §3.1.3 lists them).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -173,6 +167,15 @@ pub struct Params {
     pub eta: f32,
 }
 
+impl Params {
+    /// The flat [`Model::from_params`] order
+    /// (`c0a, c0b, k0, c1a, c1b, k1, x0, alpha_a, alpha_b, gamma, beta, A, n, eta`).
+    pub const fn flat(&self) -> [f32; 14] {
+        let p = self;
+        [p.c0a, p.c0b, p.k0, p.c1a, p.c1b, p.k1, p.x0, p.alpha_a, p.alpha_b, p.gamma, p.beta, p.a, p.n, p.eta]
+    }
+}
+
 /// How `z` is advanced along `Δw` (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Shape {
@@ -185,7 +188,7 @@ enum Shape {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Spencer {
     /// The parameters as given.
-    pub p: Params,
+    p: Params,
     dt: f32,
     /// `(A/(β+γ))^(1/n)`, the bound of |z|.
     zmax: f32,
@@ -201,6 +204,15 @@ pub struct Spencer {
     filter: CommandFilter,
     /// Command filter over 1/m of the step, m = 1 ..= MAX_STAGES.
     stage_filters: [CommandFilter; MAX_STAGES],
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl Spencer {
+    /// The parameters as given.
+    #[inline]
+    pub fn params(&self) -> &Params {
+        &self.p
+    }
 }
 
 /// State of [`Spencer`].
@@ -233,64 +245,24 @@ impl Finite for State {
 
 pub type Registered = Spencer;
 
-/// θ of the exponentially fitted θ-method: `1/(1 − e^{−x}) − 1/x` (→ ½ as x → 0).
-///
-/// Below 1 (every stage of the published set and of the fits on the Dyke files) its
-/// Bernoulli series to x⁹, `½ + x/12 − x³/720 + x⁵/30240 − x⁷/1209600 + x⁹/47900160`
-/// (truncation < 6e-10), which needs neither `expm1` nor a division.
-#[inline]
-fn fitted_theta(x: f32) -> f32 {
-    if x < 1.0 {
-        let x2 = x * x;
-        0.5 + x
-            * (1.0 / 12.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 30_240.0 + x2 * (-1.0 / 1_209_600.0 + x2 / 47_900_160.0))))
-    } else if x > 30.0 {
-        1.0 - 1.0 / x
-    } else {
-        -1.0 / expm1(-x) - 1.0 / x
-    }
-}
-
-/// `(eˣ − 1)/x`, total (capped for large x so that it never returns ∞ or NaN).
-#[inline]
-fn phi1(x: f32) -> f32 {
-    if abs(x) < 1e-4 {
-        1.0 + 0.5 * x
-    } else if x > 60.0 {
-        expm1(60.0) / 60.0
-    } else {
-        expm1(x) / x
-    }
-}
-
-/// `ln(1 + t)/t` for t > −1 (→ 1 as t → 0).
-#[inline]
-fn ln1p_over(t: f32) -> f32 {
-    if abs(t) < 1e-3 {
-        1.0 - 0.5 * t + t * t / 3.0
-    } else {
-        ln(1.0 + t) / t
-    }
-}
-
-/// `atanh(x)` for 0 ≤ x < 1.
-#[inline]
-fn atanh(x: f32) -> f32 {
-    if x < 1e-3 {
-        x + x * x * x / 3.0
-    } else {
-        0.5 * ln((1.0 + x) / (1.0 - x))
-    }
-}
-
-/// `tan(φ)` for |φ| < π/2 from the sine alone.
-#[inline]
-fn tan(phi: f32) -> f32 {
-    sin(phi) / sin(phi + core::f32::consts::FRAC_PI_2)
-}
-
 impl Spencer {
     /// Validate the parameters (bounds in [`Params`]) and precompute the step constants.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::spencer::{Spencer, DYKE_1997};
+    /// use model_core::{Kin, Model};
+    ///
+    /// let dt = 1.0 / 3000.0;
+    /// let model = Spencer::new(DYKE_1997, dt)?;
+    /// let first = Kin::new(0.0, 0.0, 0.0, 1.0); // x in cm, 1 V
+    /// let mut state = model.initial_state(&first);
+    /// let _ = model.step(&mut state, &first); // the first sample sets the rest state
+    /// let force = model.step(&mut state, &Kin::new(0.001, 3.0, 0.0, 1.0));
+    /// assert!(force.is_finite() && state.z.abs() <= model.z_max());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(p: Params, dt: f32) -> Result<Self, ParamError> {
         let big = 1e12;
         let dt = time_step(dt)?;
@@ -371,254 +343,11 @@ impl Spencer {
         let p = &self.p;
         (p.alpha_a + p.alpha_b * u, p.c0a + p.c0b * u, p.c1a + p.c1b * u)
     }
-
-    /// `dζ/dD = A − β|ζ|ⁿ − γ·ζ·|ζ|ⁿ⁻¹` (≥ 0 within the bound), ζ = z·sgn(Δw).
-    #[inline]
-    fn slope(&self, zeta: f32) -> f32 {
-        let p = &self.p;
-        let m = abs(zeta);
-        let g = match self.shape {
-            Shape::One => p.a - p.beta * m - p.gamma * zeta,
-            Shape::Two => p.a - p.beta * m * m - p.gamma * zeta * m,
-            Shape::General => {
-                let mn = powf(m, p.n);
-                p.a - p.beta * mn - p.gamma * crate::math::sign(zeta) * mn
-            }
-        };
-        if g > 0.0 {
-            g
-        } else {
-            0.0
-        }
-    }
-
-    /// Exact (n = 1, 2) or second-order (other n) flow of `dζ/dD = slope(ζ)` over `d ≥ 0`,
-    /// clamped to the bound.
-    #[inline]
-    fn flow(&self, zeta: f32, d: f32) -> f32 {
-        let z = match self.shape {
-            Shape::One => self.flow1(zeta, d),
-            Shape::Two => self.flow2(zeta, d),
-            Shape::General => self.flow_general(zeta, d),
-        };
-        crate::math::clamp(z, -self.zmax, self.zmax)
-    }
-
-    fn flow2(&self, zeta: f32, d: f32) -> f32 {
-        let p = &self.p;
-        let mut d = d;
-        if zeta < 0.0 {
-            // Unloading: dζ/dD = A − (β−γ)ζ².
-            let b = p.beta - p.gamma;
-            if b > 0.0 {
-                let (r, q) = (self.r_un, self.q_un);
-                if zeta <= -r {
-                    // ζ = −r is a rest point of this branch (only with γ = 0, ζ = −z_max).
-                    return zeta;
-                }
-                let t = tanh(q * d);
-                let num = zeta + r * t;
-                if num < 0.0 {
-                    return r * num / (r + zeta * t);
-                }
-                let dc = atanh(-zeta / r) / q;
-                d = (d - dc).max(0.0);
-            } else if b < 0.0 {
-                let (r, q) = (self.r_un, self.q_un);
-                let phi = atan(zeta / r) + q * d;
-                if phi < 0.0 {
-                    return r * tan(phi);
-                }
-                d = phi / q;
-            } else {
-                let z1 = zeta + p.a * d;
-                if z1 < 0.0 {
-                    return z1;
-                }
-                d = z1 / p.a;
-            }
-            // Continue from ζ = 0 on the loading branch.
-            let r = self.zmax;
-            return r * tanh(self.q_load * d);
-        }
-        // Loading: dζ/dD = A − (β+γ)ζ², ζ(∞) = z_max.
-        let r = self.zmax;
-        let x = self.q_load * d;
-        if abs(x) <= 0.25 {
-            // tanh = E/(E + 2) with E = e²ˣ − 1, folded into the one division.
-            let e = expm1_small(2.0 * x);
-            return r * (zeta * (e + 2.0) + r * e) / (r * (e + 2.0) + zeta * e);
-        }
-        let t = tanh(x);
-        r * (zeta + r * t) / (r + zeta * t)
-    }
-
-    fn flow1(&self, zeta: f32, d: f32) -> f32 {
-        let p = &self.p;
-        let mut d = d;
-        if zeta < 0.0 {
-            // Unloading: dζ/dD = A − (β−γ)|ζ| = A + bζ.
-            let b = p.beta - p.gamma;
-            let k = p.a + b * zeta;
-            let z1 = if k > 0.0 { zeta + k * d * phi1(b * d) } else { zeta };
-            if z1 < 0.0 || k.is_nan() || k <= 0.0 {
-                return z1;
-            }
-            let dc = (-zeta / p.a) * ln1p_over(b * zeta / p.a);
-            d = (d - dc).max(0.0);
-            return self.zmax * -expm1(-self.q_load * d);
-        }
-        // Loading: dζ/dD = A − (β+γ)ζ.
-        zeta - (self.zmax - zeta) * expm1(-self.q_load * d)
-    }
-
-    /// General n, in normalised units `q = ζ/z_max`, `s = A·D/z_max`:
-    /// - unloading (`q < 0`): `dq/ds = 1 − ρ·|q|ⁿ`, `ρ = (β−γ)/(β+γ) ∈ (−1, 1]`, smooth and
-    ///   bounded away from 0; the distance to `q = 0` by two-point Gauss–Legendre, the
-    ///   path inside the branch by two RK4 steps;
-    /// - loading (`q ≥ 0`): `dq/ds = 1 − qⁿ = (1 − q²)·r(q)` with the saturating factor kept
-    ///   exact (`atanh q` grows at rate `r`) and the smooth `r(q) = (1 − qⁿ)/(1 − q²)`
-    ///   (1 at q = 0, n/2 at q = 1) frozen at the midpoint, over two halves of `s`.
-    fn flow_general(&self, zeta: f32, d: f32) -> f32 {
-        let p = &self.p;
-        let zm = self.zmax;
-        let mut q = zeta / zm;
-        let mut s = p.a * d / zm;
-        if q < 0.0 {
-            let rho = (p.beta - p.gamma) / (p.beta + p.gamma);
-            let gu = |q: f32| 1.0 - rho * powf(abs(q), p.n);
-            if gu(q) <= 0.0 {
-                // Rest point of the unloading branch (only with γ = 0, ζ = −z_max).
-                return zeta;
-            }
-            let (g1, g2) = (0.211_324_87, 0.788_675_1);
-            let sc = -q * 0.5 * (1.0 / gu(q * g1) + 1.0 / gu(q * g2));
-            if s < sc {
-                let h = 0.5 * s;
-                for _ in 0..2 {
-                    let k1 = gu(q);
-                    let k2 = gu(q + 0.5 * h * k1);
-                    let k3 = gu(q + 0.5 * h * k2);
-                    let k4 = gu(q + h * k3);
-                    q += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-                }
-                return zm * q.min(0.0);
-            }
-            s -= sc;
-            q = 0.0;
-        }
-        let ratio = |q: f32| {
-            let e = 1.0 - q;
-            if e < 1e-3 {
-                0.5 * p.n * (1.0 - 0.5 * (p.n - 2.0) * e)
-            } else {
-                (1.0 - powf(q, p.n)) / (1.0 - q * q)
-            }
-        };
-        let tanh_step = |q: f32, x: f32| {
-            let t = tanh(x);
-            (q + t) / (1.0 + q * t)
-        };
-        let h = 0.5 * s;
-        for _ in 0..2 {
-            let qh = tanh_step(q, 0.5 * h * ratio(q));
-            q = tanh_step(q, h * ratio(qh));
-        }
-        zm * q
-    }
-
-    /// One stage of length `h`: the drive `c1·ẋ` is linear over the stage (`h·ẋ` at its ends
-    /// `hx0`, `hx1`) and the filtered command goes from `u0` to `u1`. When the frozen-state
-    /// prediction of `ẇ` changes sign inside the stage (a reversal of the Bouc–Wen stroke),
-    /// the stage is split there so that each part moves `w` one way. Returns `(w₁, z₁)`.
-    #[inline]
-    fn stage(&self, w0: f32, z0: f32, (hx0, hx1): (f32, f32), (u0, u1): (f32, f32), h: f32) -> (f32, f32) {
-        let f = self.drive(w0, z0, (hx0, hx1), (u0, u1), h);
-        let (f0, f1) = f;
-        if (f0 > 0.0 && f1 < 0.0) || (f0 < 0.0 && f1 > 0.0) {
-            let tau = f0 / (f0 - f1);
-            if tau > 0.05 && tau < 0.95 {
-                let hx_mid = hx0 + (hx1 - hx0) * tau;
-                let u_mid = u0 + (u1 - u0) * tau;
-                let hx = (tau * hx0, tau * hx_mid);
-                let f = self.drive(w0, z0, hx, (u0, u_mid), tau * h);
-                let (wm, zm) = self.stage_mono(w0, z0, f, u_mid, tau * h);
-                let rest = 1.0 - tau;
-                let (hx, u) = ((rest * hx_mid, rest * hx1), (u_mid, u1));
-                let f = self.drive(wm, zm, hx, u, rest * h);
-                return self.stage_mono(wm, zm, f, u1, rest * h);
-            }
-        }
-        self.stage_mono(w0, z0, f, u1, h)
-    }
-
-    /// `h·ẇ` at both ends of a stage with `z`, `w` frozen at the start (eq. 5).
-    #[inline]
-    fn drive(&self, w0: f32, z0: f32, (hx0, hx1): (f32, f32), (u0, u1): (f32, f32), h: f32) -> (f32, f32) {
-        let k0 = self.p.k0;
-        let (al0, c00, c10) = self.coefficients(u0);
-        let (al1, c01, c11) = self.coefficients(u1);
-        let f0 = (c10 * hx0 - h * (al0 * z0 + k0 * w0)) / (c00 + c10);
-        let f1 = (c11 * hx1 - h * (al1 * z0 + k0 * w0)) / (c01 + c11);
-        (f0, f1)
-    }
-
-    /// The exponentially fitted θ-step over one stage (module docs, item 2), from the stage's
-    /// [`drive`](Self::drive) `(f0, f1)` and the filtered command `u1` at its end.
-    #[inline]
-    fn stage_mono(&self, w0: f32, z0: f32, (f0, f1): (f32, f32), u1: f32, h: f32) -> (f32, f32) {
-        let k0 = self.p.k0;
-        let (al1, c01, c11) = self.coefficients(u1);
-        let s1 = c01 + c11;
-        // Branch from the trapezoidal prediction, then θ fitted to λ on that branch.
-        let dir = if f0 + f1 < 0.0 { -1.0 } else { 1.0 };
-        let h_s1 = h / s1;
-        let lam_h = h_s1 * (k0 + al1 * self.slope(dir * z0));
-        let theta = fitted_theta(lam_h);
-        let r = (1.0 - theta) * f0 + theta * f1;
-        let a = 1.0 + theta * h_s1 * k0;
-        let b = theta * h_s1 * al1;
-        let sgn = if r < 0.0 { -1.0 } else { 1.0 };
-        let (d, zeta1) = self.solve(sgn * z0, a, b, sgn * r);
-        (w0 + sgn * d, sgn * zeta1)
-    }
-
-    /// Solve `a·D + b·(ζ(D) − ζ₀) = r` for `D ∈ [0, r/a]` (r ≥ 0); returns `(D, ζ(D))`.
-    fn solve(&self, zeta0: f32, a: f32, b: f32, r: f32) -> (f32, f32) {
-        if r.is_nan() || r <= 0.0 {
-            return (0.0, zeta0);
-        }
-        let mut lo = 0.0f32;
-        let mut hi = r / a;
-        // Linearised start (the linearly implicit step).
-        let mut d = r / (a + b * self.slope(zeta0));
-        for _ in 0..NEWTON_ITERS {
-            let zeta = self.flow(zeta0, d);
-            let h = a * d + b * (zeta - zeta0) - r;
-            if h > 0.0 {
-                hi = d;
-            } else if h < 0.0 {
-                lo = d;
-            } else {
-                return (d, zeta);
-            }
-            let g = self.slope(zeta);
-            let mut next = d - h / (a + b * g);
-            if !(next >= lo && next <= hi) {
-                next = 0.5 * (lo + hi);
-            } else if abs(next - d) <= 2e-6 * d {
-                // Converged by a Newton step: ζ moves with D at slope g over a step this
-                // small (the second-order term is ~1e-12 of ζ), so no further flow is needed.
-                return (next, crate::math::clamp(zeta + g * (next - d), -self.zmax, self.zmax));
-            }
-            d = next;
-        }
-        // ζ consistent with the returned D.
-        (d, self.flow(zeta0, d))
-    }
 }
 
-/// Spencer et al. (1997) parameters for the Dyke damper, `shared/data/dyke/README.md`.
+/// Spencer, Dyke, Sain & Carlson (1997) for the prototype damper of `shared/data/dyke`
+/// (x in cm, F in N, v in V), as listed in `shared/data/dyke/README.md` and seed 001
+/// §3.1.3. [`DYKE_1997_FLAT`] is the same set in [`Model::from_params`] order.
 pub const DYKE_1997: Params = Params {
     c0a: 21.0,
     c0b: 3.50,
@@ -635,6 +364,10 @@ pub const DYKE_1997: Params = Params {
     n: 2.0,
     eta: 190.0,
 };
+
+/// [`DYKE_1997`] in [`Model::from_params`] order
+/// (`c0a, c0b, k0, c1a, c1b, k1, x0, alpha_a, alpha_b, gamma, beta, A, n, eta`).
+pub const DYKE_1997_FLAT: [f32; 14] = DYKE_1997.flat();
 
 impl Model for Spencer {
     type State = State;
@@ -654,11 +387,7 @@ impl Model for Spencer {
     }
 
     fn write_params(&self, out: &mut [f32]) -> usize {
-        let p = &self.p;
-        write_flat(
-            &[p.c0a, p.c0b, p.k0, p.c1a, p.c1b, p.k1, p.x0, p.alpha_a, p.alpha_b, p.gamma, p.beta, p.a, p.n, p.eta],
-            out,
-        )
+        write_flat(&self.p.flat(), out)
     }
 
     fn dt(&self) -> f32 {

@@ -17,18 +17,57 @@ use crate::{Kin, Model, ParamError};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Tanh {
     /// Height α of the hysteretic part, N·m.
-    pub alpha: f32,
+    alpha: f32,
     /// Rate gain β, s per unit B.
-    pub beta: f32,
+    beta: f32,
     /// Width γ of the loop (offset inside the tanh).
-    pub gamma: f32,
+    gamma: f32,
     /// Viscous coefficient c, N·m·s per unit B.
-    pub c: f32,
+    c: f32,
     /// Stiffness k, N·m per unit B.
-    pub k: f32,
+    k: f32,
     /// Initial torque T₀, N·m.
-    pub t0: f32,
+    t0: f32,
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl Tanh {
+    /// Height α of the hysteretic part, N·m.
+    #[inline]
+    pub fn alpha(&self) -> f32 {
+        self.alpha
+    }
+
+    /// Rate gain β, s per unit B.
+    #[inline]
+    pub fn beta(&self) -> f32 {
+        self.beta
+    }
+
+    /// Width γ of the loop (offset inside the tanh).
+    #[inline]
+    pub fn gamma(&self) -> f32 {
+        self.gamma
+    }
+
+    /// Viscous coefficient c, N·m·s per unit B.
+    #[inline]
+    pub fn c(&self) -> f32 {
+        self.c
+    }
+
+    /// Stiffness k, N·m per unit B.
+    #[inline]
+    pub fn k(&self) -> f32 {
+        self.k
+    }
+
+    /// Initial torque T₀, N·m.
+    #[inline]
+    pub fn t0(&self) -> f32 {
+        self.t0
+    }
 }
 
 /// No state.
@@ -36,6 +75,29 @@ pub type State = ();
 pub type Registered = Tanh;
 
 impl Tanh {
+    /// Any finite values (seed 000 Table 5 fits negative c).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::tanh::{Tanh, SEED000_AVERAGE};
+    /// use model_core::rate::RateParams;
+    /// use model_core::{Estimator, Sample};
+    ///
+    /// let dt = 1e-4;
+    /// let [alpha, beta, gamma, c, k, t0] = SEED000_AVERAGE;
+    /// let model = Tanh::new(alpha, beta, gamma, c, k, t0, dt)?;
+    /// let est = Estimator::new(model, RateParams::backward(dt)?)?;
+    /// let mut state = est.state();
+    /// for i in 0..100 {
+    ///     let out = est.step(&mut state, Sample::new(0.01 * i as f32));
+    ///     assert!(out.flags.ok() && out.y.is_finite());
+    /// }
+    /// // A non-finite sample is ignored and the last output held.
+    /// let held = est.step(&mut state, Sample::new(f32::NAN));
+    /// assert!(!held.flags.ok() && held.y.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(alpha: f32, beta: f32, gamma: f32, c: f32, k: f32, t0: f32, dt: f32) -> Result<Self, ParamError> {
         Ok(Self {
             alpha: finite("alpha", alpha)?,
@@ -48,6 +110,10 @@ impl Tanh {
         })
     }
 }
+
+/// Seed 000 (Yang & Kermani 2023) Table 5, the average of the five per-frequency fits
+/// (clutch input B, T in N·m), in [`Model::from_params`] order `alpha, beta, gamma, c, k, t0`.
+pub const SEED000_AVERAGE: [f32; 6] = [0.495, 1.969, 1.603, -0.120, 4.790, 0.587];
 
 impl Model for Tanh {
     type State = State;

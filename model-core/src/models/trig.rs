@@ -98,8 +98,17 @@ impl Params {
 /// Validated coefficients of eq. 10–12, 31–37.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Trig {
-    pub p: Params,
+    p: Params,
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl Trig {
+    /// The parameters as given.
+    #[inline]
+    pub fn params(&self) -> &Params {
+        &self.p
+    }
 }
 
 /// No state.
@@ -143,6 +152,19 @@ const NAMES: [&str; 21] = [
 
 impl Trig {
     /// Finite coefficients; over `0 ≤ i ≤ I_MAX`: `D, B, k, c ≥ 0` and `0 ≤ C ≤ 2`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::trig::{Trig, SEED002};
+    /// use model_core::{Kin, Model};
+    ///
+    /// let model = Trig::new(SEED002, 1e-3)?;
+    /// // 50 mm/s, accelerating, at 1 A.
+    /// let force = model.step(&mut (), &Kin::new(0.0, 50.0, 100.0, 1.0));
+    /// assert!(force.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(p: Params, dt: f32) -> Result<Self, ParamError> {
         let dt = time_step(dt)?;
         for (name, v) in NAMES.iter().zip(p.flat().iter()) {

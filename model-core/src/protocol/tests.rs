@@ -46,7 +46,7 @@ fn responses_round_trip() {
 #[test]
 fn a_page_over_the_wire() {
     let c = ControlConfig::defaults(5e-5).validate().unwrap();
-    let img = ConfigImage::new("algebraic", &[4.606, -0.076, 0.033, 0.797], RateSpec::Backward, c).unwrap();
+    let img = ConfigImage::new("algebraic", &crate::models::algebraic::SEED000_AVERAGE, RateSpec::Backward, c).unwrap();
     let page = img.encode();
     let len = usize::from(u16::from_le_bytes([page[6], page[7]])) + 4;
     let mut a = PageAssembler::default();

@@ -5,7 +5,7 @@ use crate::models::bouc_wen::BoucWen;
 fn image() -> ConfigImage {
     let dt = 5e-5;
     let control = ControlConfig { kp_t: 0.2, ..ControlConfig::defaults(dt) }.validate().unwrap();
-    let p = [2.162, 0.4, 1.0, -1.486, 1.0, -0.077, 5.861, 0.0];
+    let p = crate::models::bouc_wen::SEED000_AVERAGE;
     ConfigImage::new("bouc_wen", &p, RateSpec::Kalman { q: 1e6, r: 1e-6 }, control).unwrap()
 }
 

@@ -3,7 +3,7 @@ use super::*;
 
 #[test]
 fn matches_eq14() {
-    let m = Algebraic::new(4.606, -0.076, 0.033, 0.797, 1e-3).unwrap();
+    let m = Algebraic::from_params(&SEED000_AVERAGE, 1e-3).unwrap();
     let y = m.step(&mut (), &Kin::new(1.5, 2.0, 0.0, 0.0));
     let want = 4.606 * 1.5 - 0.076 * 2.0 + 0.033 * 1.5 * 1.5f32.powi(3) + 0.797;
     assert!((y - want).abs() < 1e-5, "{y} vs {want}");

@@ -23,11 +23,9 @@ fn abw(
 }
 
 /// Seed 004 Table A17 (ABW₁, eq. 30), signs as printed.
-pub(crate) const A17: [f32; 12] =
-    [0.6424, 1.5240, 1.7321, 0.7691, 16.9435, 22.2617, 1.0026, 0.0884, 0.0042, 0.0, 0.0, 1.0];
+pub(crate) const A17: [f32; 12] = SEED004_A17;
 /// Seed 004 Table A18 (ABW₂, eq. 31), signs as printed.
-pub(crate) const A18: [f32; 12] =
-    [0.1426, 2.3705, 3.2796, 0.1191, 1.1090, 2.5201, 1.5, 0.0086, 0.1510, 0.0064, 0.2509, 2.0];
+pub(crate) const A18: [f32; 12] = SEED004_A18;
 
 /// Monotone loading from z = 0 for n = 1: `z(x) = z̄·(1 − e^{−c₁x/D})` (eq. 26
 /// integrated by hand), whatever the step size.

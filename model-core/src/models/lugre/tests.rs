@@ -4,7 +4,7 @@ use std::vec::Vec;
 
 /// Seed 000 Table 4 average.
 fn avg(dt: f32) -> LuGre {
-    LuGre::new(4.312, 5.771, 0.003, -0.151, 4.297, 5.225, dt).unwrap()
+    LuGre::from_params(&SEED000_AVERAGE, dt).unwrap()
 }
 
 #[test]
