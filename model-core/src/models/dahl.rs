@@ -29,7 +29,8 @@
 //! the state). When the velocity, taken linear over the step from `2Δx/T − ẋ_k` to the
 //! sample's `ẋ_k` (so that it integrates to `Δx`), changes sign inside the step, the update
 //! follows the path out to the turning point and back (two exact updates). The filter of eq. 11 is advanced exactly for a command linear between samples
-//! ([`CommandFilter`]). The force is eq. 8 at the end of the step with the sample's ẋ.
+//! (`CommandFilter` in `kernels::command_filter`, shared with [`spencer`](super::spencer)).
+//! The force is eq. 8 at the end of the step with the sample's ẋ.
 //! The first sample starts the model at rest: `z = 0`, `u = V`.
 
 use crate::error::{check, count, finite, time_step};

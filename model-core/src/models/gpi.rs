@@ -116,7 +116,7 @@ pub struct Gpi<const N: usize> {
 
 /// Read access to the validated parameters (set only by `new`/`from_params`).
 impl<const N: usize> Gpi<N> {
-    /// Linear gain p₀ (G[x] = p₀·x).
+    /// Linear gain p₀ (`G[x] = p₀·x`).
     #[inline]
     pub fn p0(&self) -> f32 {
         self.p0
@@ -188,7 +188,8 @@ impl<const N: usize> Gpi<N> {
     /// use model_core::{Kin, Model};
     ///
     /// // Seed 004 Table A9 (tanh envelopes, 10 operators), signs as printed.
-    /// let (rising, falling) = (EnvelopeCoeffs::new(1.2251, 0.5371, 0.2911), EnvelopeCoeffs::new(2.1285, 1.9745, 1.7202));
+    /// let rising = EnvelopeCoeffs::new(1.2251, 0.5371, 0.2911);
+    /// let falling = EnvelopeCoeffs::new(2.1285, 1.9745, 1.7202);
     /// let model = Gpi::<10>::new(Envelope::Tanh, 0.4084, 0.1185, 0.1872, 0.1920, rising, falling, 0.0, 1.0, 1e-3)?;
     /// let mut state = model.initial_state(&Kin::new(0.2, 0.0, 0.0, 0.0));
     /// let y = model.step(&mut state, &Kin::new(0.3, 0.0, 0.0, 0.0));

@@ -201,8 +201,9 @@ impl<const NH: usize, const NW: usize> HammersteinWiener<NH, NW> {
     ///
     /// let h = SigmoidNet { a: [2.0, -1.0], w: [1.5, 0.5], b: [0.1, -0.2], lin: 0.3, d: 0.05 };
     /// let w = SigmoidNet { a: [1.0], w: [0.5], b: [0.0], lin: 1.0, d: 0.0 };
-    /// // Two zeros, five poles at 0.5 (stable), v clamped to ±10.
-    /// let model = HammersteinWiener::new(h, [0.5, 0.2, 0.1], [-2.5, 2.5, -1.25, 0.3125, -0.03125], w, -10.0, 10.0, 1e-3)?;
+    /// // Numerator b₀…b₂ (two zeros), denominator f₁…f₅ with five poles at 0.5 (stable), v in ±10.
+    /// let (lin_b, lin_f) = ([0.5, 0.2, 0.1], [-2.5, 2.5, -1.25, 0.3125, -0.03125]);
+    /// let model = HammersteinWiener::new(h, lin_b, lin_f, w, -10.0, 10.0, 1e-3)?;
     /// let mut state = model.initial_state(&Kin::new(1.0, 0.0, 0.0, 0.0));
     /// let y = model.step(&mut state, &Kin::new(1.1, 0.0, 0.0, 0.0));
     /// assert!(y.is_finite());

@@ -23,7 +23,7 @@
 //!
 //! # Short steps (the firmware's hot path)
 //! At 20 kHz a step moves B by a small fraction of the relaxation length 1/α. When
-//! `α·|ΔB| + k_t·|B̈| ≤ 1/16` (see [`FAST_Y`], [`TURN_EPS`]) the step uses the same update
+//! `α·|ΔB| + k_t·|B̈| ≤ 1/16` (see `FAST_Y` here and `TURN_EPS` in `kernels::turning`) the step uses the same update
 //! with `1 − e^{−y}` written as `y·φ(y)`, `φ(y) = 1 − y/2 + y²/6 − y³/24` (error ≤ y⁴/120 <
 //! 1.3e-7 relative), and without the reversal split, whose effect there is below
 //! `TURN_EPS·|z|`. No libm call, no division: about 40 instructions on the Cortex-M4F

@@ -168,13 +168,13 @@ impl<const H: usize> Narx<H> {
     /// use model_core::{Kin, Model};
     ///
     /// let model = Narx::<2>::new(
-    ///     (1.0, 2.0, 0.5, 4.0),                                                           // u_mean, u_scale, y_mean, y_scale
-    ///     [0.6, 0.3, -0.2, 0.1, 0.05, -0.05, 0.02],                                        // linear part
+    ///     (1.0, 2.0, 0.5, 4.0), // u_mean, u_scale, y_mean, y_scale
+    ///     [0.6, 0.3, -0.2, 0.1, 0.05, -0.05, 0.02], // linear part
     ///     [[0.1, 0.2, 0.3, -0.1, 0.0, 0.5, -0.4], [-0.3, 0.1, 0.0, 0.2, 0.2, -0.1, 0.3]], // hidden weights
-    ///     [0.1, -0.2],                                                                     // hidden biases
-    ///     [1.5, -0.7],                                                                     // output weights
-    ///     0.05,                                                                            // offset
-    ///     (-100.0, 100.0),                                                                 // output clamp
+    ///     [0.1, -0.2], // hidden biases
+    ///     [1.5, -0.7], // output weights
+    ///     0.05,        // offset
+    ///     (-100.0, 100.0), // output clamp
     ///     1e-3,
     /// )?;
     /// let mut state = model.initial_state(&Kin::new(1.0, 0.0, 0.0, 0.0));

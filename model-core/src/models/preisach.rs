@@ -212,7 +212,10 @@ impl<const N: usize> Preisach<N> {
     /// use model_core::{Kin, Model};
     ///
     /// // Seed 004 Table A2 (GC), on a 10 × 10 grid over the normalised input 0…1.
-    /// let model = Preisach::<10>::new(Density::GaussCauchy, 3.2352, 11.6040, 0.0232, 0.0001, 0.0837, 1.0, 0.0, 1.0, 1e-3)?;
+    /// let (sigma_hm, mu_hm, sigma_hc, mu_hc, y0) = (3.2352, 11.6040, 0.0232, 0.0001, 0.0837);
+    /// let (scale, x_min, x_max) = (1.0, 0.0, 1.0);
+    /// let density = Density::GaussCauchy;
+    /// let model = Preisach::<10>::new(density, sigma_hm, mu_hm, sigma_hc, mu_hc, y0, scale, x_min, x_max, 1e-3)?;
     /// let mut state = model.initial_state(&Kin::new(0.0, 0.0, 0.0, 0.0));
     /// let y = model.step(&mut state, &Kin::new(0.6, 0.0, 0.0, 0.0));
     /// assert!(y.is_finite());

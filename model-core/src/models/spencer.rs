@@ -95,7 +95,8 @@
 //!    (still within 0.5 %; set `MAX_STAGES = 1` for a strict single stage). Worst case per
 //!    sample: `MAX_STAGES × 2 × NEWTON_ITERS` flow evaluations.
 //! 3. **The command filter** (eq. 7) is advanced exactly for a raw command linear between
-//!    samples and clamped at 0 V ([`CommandFilter`]): for `v ≥ 0`,
+//!    samples and clamped at 0 V (`CommandFilter` in `kernels::command_filter`, shared
+//!    with [`dahl`](super::dahl)): for `v ≥ 0`,
 //!    `u₁ = v₁ + (u₀ − v₀)·e^{−ηT} − (v₁ − v₀)·(1 − e^{−ηT})/(ηT)`, a step crossing 0 V is
 //!    split at the crossing. The coefficients of eq. 6 use `u` at both ends of each stage.
 //!

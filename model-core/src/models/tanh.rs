@@ -3,7 +3,7 @@
 //! `T = c·Ḃ + k·B + α·z + T₀`,  `z = tanh(β·Ḃ + γ·sign(B))`.
 //!
 //! Stateless: the loop comes from the rate term inside the tanh. `sign(0) = 0`. The tanh
-//! is [`tanh_fast`](crate::math::tanh_fast) (no libm call in the hot path; within 5e-7 of
+//! is [`tanh_fast`] (no libm call in the hot path; within 5e-7 of
 //! the exact tanh).
 //! Parameters (flat order, seed 000 Table 2/5): `alpha, beta, gamma, c, k, t0`, any finite
 //! values (Table 5 fits negative c).

@@ -7,7 +7,7 @@ use crate::math::{exp, expm1};
 
 /// Eq. 7 (and seed 001 eq. 11), `u̇ = −η(u − max(v, 0))`, advanced exactly over one step
 /// for a raw command `v` linear between samples and clamped at 0 V (a step whose command
-/// crosses 0 V is split at the crossing). Shared by [`spencer`](super::super::spencer) and [`dahl`](super::super::dahl).
+/// crosses 0 V is split at the crossing).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CommandFilter {
     /// `ηT`
