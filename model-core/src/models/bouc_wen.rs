@@ -84,7 +84,9 @@
 
 use crate::error::{check, count, finite, time_step};
 use crate::math::{abs, clamp, powf, sign};
+use crate::model::write_flat;
 use crate::models::kernels::turning::{turning_point, TURN_EPS};
+use crate::{Finite, Kin, Model, ParamError};
 use region::{region_n1, region_n2, Leg};
 
 mod region;
@@ -98,8 +100,6 @@ const FAST_Y: f32 = 0.02;
 fn phi2(y: f32) -> f32 {
     1.0 + y * (-0.5 + y * (1.0 / 6.0))
 }
-use crate::model::write_flat;
-use crate::{Finite, Kin, Model, ParamError};
 
 /// Largest admissible exponent n.
 pub const N_MAX: f32 = 10.0;

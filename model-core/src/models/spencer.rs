@@ -122,11 +122,11 @@ use crate::error::{check, count, finite, time_step};
 use crate::math::{abs, powf, sqrt};
 use crate::model::write_flat;
 use crate::models::kernels::command_filter::{command, raw_command, CommandFilter};
+use crate::{Finite, Kin, Model, ParamError};
 use solver::stage_count;
 
 mod flow;
 mod solver;
-use crate::{Finite, Kin, Model, ParamError};
 
 /// Maximum number of flow evaluations in the Newton solve for `Δw`.
 pub const NEWTON_ITERS: usize = 6;
