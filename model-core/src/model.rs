@@ -58,6 +58,19 @@ pub trait Model: Copy + core::fmt::Debug + 'static {
 
     /// Advance one sample and return the model output (torque or force).
     ///
+    /// ```
+    /// use model_core::models::bouc_wen::{BoucWen, SEED000_AVERAGE};
+    /// use model_core::{Kin, Model};
+    ///
+    /// let model = BoucWen::from_params(&SEED000_AVERAGE, 1e-4)?;
+    /// let first = Kin::new(1.5, 0.0, 0.0, 0.0);
+    /// let mut state = model.initial_state(&first);
+    /// // B, Ḃ, B̈ and the command as the rate estimator (or the caller) has them.
+    /// let torque = model.step(&mut state, &Kin::new(1.5002, 2.0, 0.0, 0.0));
+    /// assert!(torque.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
+    ///
     /// Must not panic for any input; must keep the state within its analytic bound.
     /// With finite, moderate inputs the output is finite; the [`Estimator`](crate::Estimator)
     /// guards the rest.

@@ -157,7 +157,7 @@ proptest! {
         };
         let m: Pi = check_params(&v, DTS[dt_index], nan_at, &bad)?;
         run(&m, dt_index, &xs, 1e6, &|m, s, x| {
-            for (z, r) in s.z.iter().zip(m.r) {
+            for (z, r) in s.z.iter().zip(*m.r()) {
                 prop_assert!(*z >= x - r && *z <= x + r, "play output {z} outside {x} ± {r}");
             }
             Ok(())

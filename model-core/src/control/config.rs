@@ -20,6 +20,12 @@
 use crate::error::{check, time_step};
 use crate::ParamError;
 
+mod coeffs;
+mod crc;
+
+pub use coeffs::{Coeffs, SLOW_TIMEOUT_S};
+pub use crc::{crc32_update, crc_words};
+
 /// What the torque reference means and how the loop is closed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LoopMode {
@@ -341,126 +347,6 @@ impl ControlConfig {
     }
 }
 
-/// What the per-sample step reads, pre-computed once from a validated [`ControlConfig`]
-/// ([`Coeffs::new`]; the slow supervisor re-computes it and compares). Units as in
-/// [`ControlConfig`].
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Coeffs {
-    pub mode: LoopMode,
-    /// T per count, A per count.
-    pub hall_gain: f32,
-    pub current_gain: f32,
-    /// Hall counts in range: `hall − rail_base < rail_span` (wrapping, u32), i.e.
-    /// `hall_rail_lo < hall < hall_rail_hi`.
-    pub rail_base: u32,
-    pub rail_span: u32,
-    /// Hall counts at or above this are the upper rail (`⌈hall_rail_hi⌉`).
-    pub rail_hi: u32,
-    /// Over-current trip, A; supply window, V.
-    pub over_current: f32,
-    pub v_min: f32,
-    pub v_max: f32,
-    /// Consecutive samples a fast condition (rail, over-current, supply, overrun, model)
-    /// must persist.
-    pub confirm: u32,
-    /// Samples of the slow-developing checks (`u32::MAX`: disabled).
-    pub stuck_n: u32,
-    pub open_n: u32,
-    pub band_n: u32,
-    /// Reversing Hall jumps within 8 samples that trip the noise check.
-    pub slew_n: u32,
-    /// Largest plausible Hall change per sample in counts (`b_slew_max/hall_gain`).
-    pub slew_counts: u32,
-    /// Coil-open check: V, A.
-    pub open_v: f32,
-    pub open_i: f32,
-    /// Plausibility band, T (`+∞`: disabled), and the B/i slope, T/A.
-    pub b_band: f32,
-    pub b_per_amp: f32,
-    /// `1/b_per_amp`, A/T; the feed-forward's lead per torque-loop update (two samples),
-    /// `ff_lead_s/(2·dt)` (1).
-    pub amp_per_b: f32,
-    pub lead: f32,
-    /// Feed-forward: the range of B* (`[0, b_max − h]`, T), the forward-difference width
-    /// `h = 10⁻³·b_max` (T), the largest Newton step (T).
-    pub ff_hi: f32,
-    pub ff_h: f32,
-    pub ff_step: f32,
-    /// Reference limit (N·m, or A in current mode) and the current limit, A.
-    pub ref_lim: f32,
-    pub i_max: f32,
-    /// Torque PI: A/(N·m), A/(N·m) per update (the torque loop runs every second sample:
-    /// `ki_t·2·dt`); current PI: V/A, V/A per sample.
-    pub kp_t: f32,
-    pub ki_t_dt: f32,
-    pub kp_i: f32,
-    pub ki_i_dt: f32,
-    /// Coil resistance, Ω.
-    pub coil_r: f32,
-    /// Largest |duty|, PWM counts for duty 1.
-    pub duty_max: f32,
-    pub pwm_counts: f32,
-    /// Demagnetising pulse: duty, samples, arming threshold.
-    pub demag_duty: f32,
-    pub demag_samples: u16,
-    pub demag_threshold: f32,
-    /// Samples without a slow-supervisor pass before the step trips
-    /// [`FaultCode::SupervisorStalled`](super::FaultCode::SupervisorStalled) (0.1 s).
-    pub slow_timeout: u32,
-}
-
-/// The slow supervisor must pass at least this often (s).
-pub const SLOW_TIMEOUT_S: f32 = 0.1;
-
-impl Coeffs {
-    /// Pre-compute from settings that passed [`ControlConfig::validate`].
-    pub fn new(c: &ControlConfig) -> Self {
-        let count = |n: f32| if n > 0.0 { n as u32 } else { 0 };
-        let rail_lo = libm::floorf(c.hall_rail_lo) as u32;
-        let rail_hi = libm::ceilf(c.hall_rail_hi) as u32;
-        let h = 1e-3 * c.b_max;
-        Self {
-            mode: c.mode,
-            hall_gain: c.hall_gain,
-            current_gain: c.current_gain,
-            rail_base: rail_lo.saturating_add(1),
-            rail_span: rail_hi.saturating_sub(rail_lo.saturating_add(1)),
-            rail_hi,
-            over_current: c.over_current,
-            v_min: c.v_min,
-            v_max: c.v_max,
-            confirm: count(c.confirm_samples),
-            stuck_n: if c.stuck_samples > 0.0 { count(c.stuck_samples) } else { u32::MAX },
-            open_n: count(c.open_samples),
-            band_n: count(c.band_samples),
-            slew_n: count(c.slew_count),
-            slew_counts: (c.b_slew_max / c.hall_gain) as u32,
-            open_v: c.open_v,
-            open_i: c.open_i,
-            b_band: if c.b_band > 0.0 { c.b_band } else { f32::INFINITY },
-            b_per_amp: c.b_per_amp,
-            amp_per_b: 1.0 / c.b_per_amp,
-            lead: c.ff_lead_s / (2.0 * c.dt),
-            ff_hi: c.b_max - h,
-            ff_h: h,
-            ff_step: 0.25 * c.b_max,
-            ref_lim: if c.mode == LoopMode::Current { c.i_max } else { c.torque_max },
-            i_max: c.i_max,
-            kp_t: c.kp_t,
-            ki_t_dt: c.ki_t * (2.0 * c.dt),
-            kp_i: c.kp_i,
-            ki_i_dt: c.ki_i * c.dt,
-            coil_r: c.coil_r,
-            duty_max: c.duty_max,
-            pwm_counts: c.pwm_counts,
-            demag_duty: c.demag_duty,
-            demag_samples: count(c.demag_samples).min(u32::from(u16::MAX)) as u16,
-            demag_threshold: c.demag_threshold,
-            slow_timeout: count(libm::ceilf(SLOW_TIMEOUT_S / c.dt)),
-        }
-    }
-}
-
 /// A configuration that passed [`ControlConfig::validate`], with the CRC of its encoding
 /// (stored with it) and the fingerprint the running check compares against.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -573,90 +459,5 @@ impl ValidatedConfig {
     }
 }
 
-/// CRC-32 over the little-endian bytes of `words`.
-pub fn crc_words(words: &[f32]) -> u32 {
-    !words.iter().fold(!0u32, |c, w| crc32_update(c, &w.to_le_bytes()))
-}
-
-/// Nibble table of CRC-32 (reflected 0xEDB88320). Built at compile time: an index out
-/// of bounds here would be a compile error, not a panic.
-#[allow(clippy::indexing_slicing)]
-const NIBBLE: [u32; 16] = {
-    let mut t = [0u32; 16];
-    let mut i = 0;
-    while i < 16 {
-        let mut c = i as u32;
-        let mut k = 0;
-        while k < 4 {
-            c = if c & 1 != 0 { (c >> 1) ^ 0xEDB8_8320 } else { c >> 1 };
-            k += 1;
-        }
-        t[i] = c;
-        i += 1;
-    }
-    t
-};
-
-/// Update a running (pre-inverted) CRC-32 with `bytes`.
-#[inline]
-pub fn crc32_update(mut crc: u32, bytes: &[u8]) -> u32 {
-    for &b in bytes {
-        crc ^= u32::from(b);
-        for _ in 0..2 {
-            crc = (crc >> 4) ^ NIBBLE.get((crc & 0xF) as usize).copied().unwrap_or(0);
-        }
-    }
-    crc
-}
-
 #[cfg(test)]
-mod tests {
-    #![allow(clippy::unwrap_used)]
-    use super::*;
-
-    #[test]
-    fn crc_is_the_ieee_crc32() {
-        // The check value of CRC-32/ISO-HDLC: "123456789" → 0xCBF43926.
-        assert_eq!(!crc32_update(!0, b"123456789"), 0xCBF4_3926);
-    }
-
-    #[test]
-    fn bytes_round_trip_and_detect_corruption() {
-        let v = ControlConfig::defaults(1e-4).validate().unwrap();
-        let bytes = v.to_bytes();
-        assert_eq!(ValidatedConfig::from_bytes(&bytes).unwrap(), v);
-        for bit in [0usize, 77, 8 * BYTES - 1] {
-            let mut b = bytes;
-            if let Some(x) = b.get_mut(bit / 8) {
-                *x ^= 1 << (bit % 8);
-            }
-            assert!(matches!(ValidatedConfig::from_bytes(&b), Err(ConfigError::CrcMismatch { .. })), "bit {bit}");
-        }
-    }
-
-    #[test]
-    fn validation_rejects_bad_values() {
-        let d = ControlConfig::defaults(1e-4);
-        assert!(ControlConfig { dt: 0.0, ..d }.validate().is_err());
-        assert!(ControlConfig { kp_i: f32::NAN, ..d }.validate().is_err());
-        assert!(ControlConfig { over_current: 1.0, ..d }.validate().is_err()); // below i_max
-        assert!(ControlConfig { calib_samples: 2.5, ..d }.validate().is_err());
-        assert!(ControlConfig { hall_rail_hi: 10.0, ..d }.validate().is_err());
-    }
-
-    #[test]
-    fn verify_finds_any_flipped_bit() {
-        let v = ControlConfig::defaults(1e-4).validate().unwrap();
-        assert!(v.verify());
-        for bit in [0u32, 31, 500, 1407] {
-            let mut bad = v;
-            bad.inject_bit_flip(bit);
-            assert_ne!(bad.get().to_words().map(f32::to_bits), v.get().to_words().map(f32::to_bits), "bit {bit}");
-            assert!(!bad.verify(), "bit {bit}");
-        }
-        // A stray write to a coefficient (not to the settings) is caught too.
-        let mut bad = v;
-        bad.k.ki_i_dt = f32::from_bits(bad.k.ki_i_dt.to_bits() ^ 1);
-        assert!(!bad.verify());
-    }
-}
+mod tests;

@@ -14,14 +14,41 @@ use crate::{Kin, Model, ParamError};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Algebraic {
     /// Stiffness k, N·m per unit B.
-    pub k: f32,
+    k: f32,
     /// Damping c, N·m·s per unit B.
-    pub c: f32,
+    c: f32,
     /// Power-law coefficient α, N·m per unit B⁴.
-    pub alpha: f32,
+    alpha: f32,
     /// Initial torque T₀, N·m.
-    pub t0: f32,
+    t0: f32,
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl Algebraic {
+    /// Stiffness k, N·m per unit B.
+    #[inline]
+    pub fn k(&self) -> f32 {
+        self.k
+    }
+
+    /// Damping c, N·m·s per unit B.
+    #[inline]
+    pub fn c(&self) -> f32 {
+        self.c
+    }
+
+    /// Power-law coefficient α, N·m per unit B⁴.
+    #[inline]
+    pub fn alpha(&self) -> f32 {
+        self.alpha
+    }
+
+    /// Initial torque T₀, N·m.
+    #[inline]
+    pub fn t0(&self) -> f32 {
+        self.t0
+    }
 }
 
 /// The algebraic model has no state.
@@ -30,6 +57,21 @@ pub type Registered = Algebraic;
 
 impl Algebraic {
     /// Any finite k, c, α, T₀ (seed 000 Table 6 fits negative c and α).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::algebraic::{Algebraic, SEED000_AVERAGE};
+    /// use model_core::{Kin, Model};
+    ///
+    /// let [k, c, alpha, t0] = SEED000_AVERAGE;
+    /// let model = Algebraic::new(k, c, alpha, t0, 1e-4)?;
+    /// let mut state = model.initial_state(&Kin::new(1.5, 0.0, 0.0, 0.0));
+    /// // B = 1.5 mT rising at 2 mT/s.
+    /// let torque = model.step(&mut state, &Kin::new(1.5, 2.0, 0.0, 0.0));
+    /// assert!((torque - (k * 1.5 + c * 2.0 + alpha * 1.5f32.powi(4) + t0)).abs() < 1e-4);
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(k: f32, c: f32, alpha: f32, t0: f32, dt: f32) -> Result<Self, ParamError> {
         Ok(Self {
             k: finite("k", k)?,
@@ -40,6 +82,10 @@ impl Algebraic {
         })
     }
 }
+
+/// Seed 000 (Yang & Kermani 2023) Table 6, the average of the five per-frequency fits
+/// (B in mT, T in N·m), in [`Model::from_params`] order `k, c, alpha, t0`.
+pub const SEED000_AVERAGE: [f32; 4] = [4.606, -0.076, 0.033, 0.797];
 
 impl Model for Algebraic {
     type State = State;
@@ -71,82 +117,7 @@ impl Model for Algebraic {
 }
 
 #[cfg(test)]
-mod tests {
-    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
-    use super::*;
-
-    #[test]
-    fn matches_eq14() {
-        let m = Algebraic::new(4.606, -0.076, 0.033, 0.797, 1e-3).unwrap();
-        let y = m.step(&mut (), &Kin::new(1.5, 2.0, 0.0, 0.0));
-        let want = 4.606 * 1.5 - 0.076 * 2.0 + 0.033 * 1.5 * 1.5f32.powi(3) + 0.797;
-        assert!((y - want).abs() < 1e-5, "{y} vs {want}");
-    }
-
-    #[test]
-    fn rejects_non_finite() {
-        assert!(Algebraic::new(f32::NAN, 0.0, 0.0, 0.0, 1e-3).is_err());
-        assert!(Algebraic::new(1.0, 0.0, 0.0, 0.0, 0.0).is_err());
-        assert!(Algebraic::from_params(&[1.0, 2.0], 1e-3).is_err());
-    }
-}
+mod tests;
 
 #[cfg(test)]
-mod fig5_tests {
-    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
-    use super::*;
-    use std::vec::Vec;
-
-    /// One period (after a period of transient) of the T–B loop under the seed 000 Fig. 5
-    /// input, B = sin(2π·1 Hz·t) (−1 to 1), sampled at `n` points per period with the
-    /// analytic rate. Returns (shoelace area, peak-to-peak torque).
-    fn loop_of(c: f32, alpha: f32) -> (f64, f64) {
-        let n = 2000;
-        let m = Algebraic::new(1.0, c, alpha, 0.0, 1.0 / n as f32).unwrap();
-        let w = 2.0 * core::f64::consts::PI;
-        let pts: Vec<(f64, f64)> = (0..2 * n)
-            .map(|i| {
-                let t = i as f64 / n as f64;
-                let (b, bd) = ((w * t).sin(), w * (w * t).cos());
-                (b, f64::from(m.step(&mut (), &Kin::new(b as f32, bd as f32, 0.0, 0.0))))
-            })
-            .skip(n)
-            .collect();
-        let mut s = 0.0;
-        for i in 0..n {
-            let (p, q) = (pts[i], pts[(i + 1) % n]);
-            s += p.0 * q.1 - q.0 * p.1;
-        }
-        let hi = pts.iter().map(|p| p.1).fold(f64::MIN, f64::max);
-        let lo = pts.iter().map(|p| p.1).fold(f64::MAX, f64::min);
-        (0.5 * s.abs(), hi - lo)
-    }
-
-    #[test]
-    fn fig5_loop_area_grows_with_c() {
-        // ∮T dB = c·∮Ḃ dB = c·∫Ḃ²dt = c·2π² for a unit 1 Hz sine: linear in c.
-        let mut prev = 0.0;
-        for c in [0.01f32, 0.05, 0.1, 0.2, 0.4] {
-            let (a, _) = loop_of(c, 0.5);
-            let want = f64::from(c) * 2.0 * core::f64::consts::PI.powi(2);
-            assert!((a - want).abs() < 1e-3 * want + 1e-6, "c={c}: {a} vs {want}");
-            assert!(a > prev);
-            prev = a;
-        }
-    }
-
-    #[test]
-    fn fig5_loop_size_grows_with_alpha() {
-        // α|B|B³ is a single-valued function of B: it bends the loop but adds no enclosed
-        // area (the shoelace area stays c·2π²); what grows with α is the loop's extent in T
-        // (the "size" of the curves in Fig. 5a).
-        let (a0, h0) = loop_of(0.1, 0.0);
-        let mut prev_h = h0;
-        for alpha in [0.5f32, 1.0, 2.0, 4.0] {
-            let (a, h) = loop_of(0.1, alpha);
-            assert!((a - a0).abs() < 1e-3 * a0, "area must not depend on α: {a} vs {a0}");
-            assert!(h > prev_h, "α={alpha}: extent {h} after {prev_h}");
-            prev_h = h;
-        }
-    }
-}
+mod fig5_tests;

@@ -24,44 +24,16 @@
 //! jumps by up to `(4/π)·fy·atan(k·ẋ0)` between samples. Use a smoothing rate estimator
 //! (`RateParams::filtered` or `kalman`) with this model. `sgn(0) = 0` (the midpoint).
 
-use crate::error::{check, count, finite, time_step};
-use crate::math::{atan, sign};
+use crate::error::{count, time_step};
 use crate::model::write_flat;
+pub use crate::models::kernels::arctan_law::Params;
+use crate::models::kernels::arctan_law::NAMES;
 use crate::{Kin, Model, ParamError};
-
-/// Parameters of eq. 16, each `[value at u = 0, slope per unit u]`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Params {
-    /// f0: pre-load, N.
-    pub f0: [f32; 2],
-    /// cb: viscous damping, N·s per unit x (zero-command value ≥ 0).
-    pub cb: [f32; 2],
-    /// fy: yield force, N (zero-command value ≥ 0).
-    pub fy: [f32; 2],
-    /// k: shape coefficient, s per unit x (zero-command value ≥ 0).
-    pub k: [f32; 2],
-    /// ẋ0: hysteretic velocity, unit x per s (zero-command value ≥ 0).
-    pub xd0: [f32; 2],
-}
-
-impl Params {
-    /// The flat order of [`Arctan::PARAM_NAMES`].
-    pub fn flat(&self) -> [f32; 10] {
-        let [a, b, c, d, e] = [self.f0, self.cb, self.fy, self.k, self.xd0];
-        [a[0], a[1], b[0], b[1], c[0], c[1], d[0], d[1], e[0], e[1]]
-    }
-
-    /// From the flat order of [`Arctan::PARAM_NAMES`].
-    pub fn from_flat(v: [f32; 10]) -> Self {
-        let [a0, a1, b0, b1, c0, c1, d0, d1, e0, e1] = v;
-        Self { f0: [a0, a1], cb: [b0, b1], fy: [c0, c1], k: [d0, d1], xd0: [e0, e1] }
-    }
-}
 
 /// Validated coefficients of eq. 16.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Arctan {
-    pub p: Params,
+    p: Params,
     dt: f32,
 }
 
@@ -69,35 +41,43 @@ pub struct Arctan {
 pub type State = ();
 pub type Registered = Arctan;
 
-const NAMES: [&str; 10] = ["f0_a", "f0_b", "cb_a", "cb_b", "fy_a", "fy_b", "k_a", "k_b", "xd0_a", "xd0_b"];
-
 impl Arctan {
     /// Finite values; `cb_a, fy_a, k_a, xd0_a ≥ 0`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::arctan::{Arctan, Params};
+    /// use model_core::{Kin, Model};
+    ///
+    /// let p = Params { f0: [20.0, 5.0], cb: [900.0, 400.0], fy: [150.0, 700.0], k: [60.0, 10.0], xd0: [0.01, 0.005] };
+    /// let model = Arctan::new(p, 1e-3)?;
+    /// // 5 cm/s, accelerating, at 1 A.
+    /// let force = model.step(&mut (), &Kin::new(0.0, 0.05, 1.0, 1.0));
+    /// assert!(force.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(p: Params, dt: f32) -> Result<Self, ParamError> {
         let dt = time_step(dt)?;
-        for (name, v) in NAMES.iter().zip(p.flat().iter()) {
-            finite(name, *v)?;
-        }
-        check("cb_a", p.cb[0], 0.0, f32::INFINITY)?;
-        check("fy_a", p.fy[0], 0.0, f32::INFINITY)?;
-        check("k_a", p.k[0], 0.0, f32::INFINITY)?;
-        check("xd0_a", p.xd0[0], 0.0, f32::INFINITY)?;
+        p.validate()?;
         Ok(Self { p, dt })
+    }
+
+    /// The parameters as given.
+    pub fn params(&self) -> &Params {
+        &self.p
     }
 
     /// `(f0, cb, fy, k, ẋ0)` at command `u`.
     #[inline]
     pub fn coefficients(&self, u: f32) -> (f32, f32, f32, f32, f32) {
-        let lin = |c: [f32; 2]| c[0] + c[1] * u;
-        let p = &self.p;
-        (lin(p.f0), lin(p.cb), lin(p.fy), lin(p.k), lin(p.xd0))
+        self.p.coefficients(u)
     }
 
     /// Eq. 16.
     #[inline]
     pub fn force(&self, k: &Kin) -> f32 {
-        let (f0, cb, fy, kk, xd0) = self.coefficients(k.u);
-        f0 + cb * k.dx + core::f32::consts::FRAC_2_PI * fy * atan(kk * (k.dx - xd0 * sign(k.ddx)))
+        self.p.force(k)
     }
 }
 
@@ -129,48 +109,4 @@ impl Model for Arctan {
 }
 
 #[cfg(test)]
-mod tests {
-    #![allow(clippy::unwrap_used)]
-    use super::*;
-
-    fn example() -> Params {
-        // Units of seed 001 (N, m/s); values only plausible (the paper publishes a plot).
-        Params { f0: [20.0, 5.0], cb: [900.0, 400.0], fy: [150.0, 700.0], k: [60.0, 10.0], xd0: [0.01, 0.005] }
-    }
-
-    /// Eq. 16 by hand on both branches of sgn(ẍ), command 1.2.
-    #[test]
-    fn matches_eq16() {
-        let m = Arctan::new(example(), 1e-3).unwrap();
-        let u = 1.2f32;
-        let (f0, cb, fy, k, x0) =
-            (20.0 + 5.0 * u, 900.0 + 400.0 * u, 150.0 + 700.0 * u, 60.0 + 10.0 * u, 0.01 + 0.005 * u);
-        for (v, a) in [(0.05f32, 3.0f32), (0.05, -3.0), (-0.02, 1.0), (0.0, 0.0)] {
-            let sg = if a > 0.0 {
-                1.0
-            } else if a < 0.0 {
-                -1.0
-            } else {
-                0.0
-            };
-            let want = f0 + cb * v + 2.0 / core::f32::consts::PI * fy * (k * (v - x0 * sg)).atan();
-            let y = m.step(&mut (), &Kin::new(0.0, v, a, u));
-            assert!((y - want).abs() < 1e-3, "v {v} a {a}: {y} vs {want}");
-        }
-        // The hysteresis: same velocity, opposite acceleration, different force.
-        let up = m.step(&mut (), &Kin::new(0.0, 0.0, 1.0, u));
-        let down = m.step(&mut (), &Kin::new(0.0, 0.0, -1.0, u));
-        assert!(down > up);
-    }
-
-    #[test]
-    fn validation_and_round_trip() {
-        let m = Arctan::new(example(), 1e-3).unwrap();
-        let mut v = [0.0; 10];
-        assert_eq!(m.write_params(&mut v), 10);
-        assert_eq!(Arctan::from_params(&v, 1e-3).unwrap(), m);
-        assert!(Arctan::from_params(&v[..9], 1e-3).is_err());
-        assert!(Arctan::new(Params { fy: [-1.0, 0.0], ..example() }, 1e-3).is_err());
-        assert!(Arctan::new(Params { k: [1.0, f32::NAN], ..example() }, 1e-3).is_err());
-    }
-}
+mod tests;

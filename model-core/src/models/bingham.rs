@@ -25,18 +25,40 @@
 
 use crate::error::{check, count, finite, time_step};
 use crate::model::write_flat;
+use crate::models::kernels::poly::poly;
 use crate::{Kin, Model, ParamError};
 
 /// Coefficients of seed 003 eq. 12–14.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bingham {
     /// `[fc0, fc1, fc2, fc3]`: friction force polynomial in u, N per uᵏ (eq. 13).
-    pub fc: [f32; 4],
+    fc: [f32; 4],
     /// `[c0_0, …, c0_4]`: damping polynomial in u, N·s per unit x per uᵏ (eq. 14).
-    pub c0: [f32; 5],
+    c0: [f32; 5],
     /// f0: accumulator force offset, N.
-    pub f0: f32,
+    f0: f32,
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl Bingham {
+    /// `[fc0, fc1, fc2, fc3]`: friction force polynomial in u, N per uᵏ (eq. 13).
+    #[inline]
+    pub fn fc(&self) -> &[f32; 4] {
+        &self.fc
+    }
+
+    /// `[c0_0, …, c0_4]`: damping polynomial in u, N·s per unit x per uᵏ (eq. 14).
+    #[inline]
+    pub fn c0(&self) -> &[f32; 5] {
+        &self.c0
+    }
+
+    /// f0: accumulator force offset, N.
+    #[inline]
+    pub fn f0(&self) -> f32 {
+        self.f0
+    }
 }
 
 /// The Bingham model has no state.
@@ -47,14 +69,22 @@ pub type Registered = Bingham;
 pub const SEED003: ([f32; 4], [f32; 5], f32) =
     ([52.19, 663.56, 986.49, -910.09], [0.53, 1.43, 66.00, -106.39, 48.74], 40.0);
 
-/// Horner evaluation of `c[0] + c[1]·u + c[2]·u² + …`.
-#[inline]
-pub(crate) fn poly(c: &[f32], u: f32) -> f32 {
-    c.iter().rev().fold(0.0, |acc, &ck| acc * u + ck)
-}
-
 impl Bingham {
     /// Every coefficient finite; `fc0 ≥ 0` and `c0_0 ≥ 0` (a passive damper at zero command).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::bingham::{Bingham, SEED003};
+    /// use model_core::{Kin, Model};
+    ///
+    /// let (fc, c0, f0) = SEED003;
+    /// let model = Bingham::new(fc, c0, f0, 1e-3)?;
+    /// // 10 mm/s at 0.5 A.
+    /// let force = model.step(&mut (), &Kin::new(0.0, 10.0, 0.0, 0.5));
+    /// assert!(force.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(fc: [f32; 4], c0: [f32; 5], f0: f32, dt: f32) -> Result<Self, ParamError> {
         let dt = time_step(dt)?;
         for (name, v) in FC_NAMES.iter().zip(fc.iter()) {
@@ -112,39 +142,4 @@ impl Model for Bingham {
 }
 
 #[cfg(test)]
-mod tests {
-    #![allow(clippy::unwrap_used)]
-    use super::*;
-
-    /// Seed 003 eq. 13–14 at I = 0.5 A by hand, and the sgn(ẋ) jump.
-    #[test]
-    fn matches_seed003_polynomials() {
-        let (fc, c0, f0) = SEED003;
-        let m = Bingham::new(fc, c0, f0, 1e-3).unwrap();
-        let i = 0.5f32;
-        let fc_want = -910.09 * i * i * i + 986.49 * i * i + 663.56 * i + 52.19;
-        let c0_want = 48.74 * i.powi(4) - 106.39 * i.powi(3) + 66.00 * i * i + 1.43 * i + 0.53;
-        let v = 20.0; // mm/s
-        let y = m.step(&mut (), &Kin::new(1.0, v, 0.0, i));
-        assert!((y - (fc_want + c0_want * v + 40.0)).abs() < 1e-2, "{y}");
-        let y = m.step(&mut (), &Kin::new(1.0, -v, 0.0, i));
-        assert!((y - (-fc_want - c0_want * v + 40.0)).abs() < 1e-2, "{y}");
-        // sgn(0) = 0: only the offset at rest.
-        assert_eq!(m.step(&mut (), &Kin::new(1.0, 0.0, 0.0, i)), 40.0);
-    }
-
-    /// The linear-in-command form is the polynomial with higher coefficients zero.
-    #[test]
-    fn linear_form_and_validation() {
-        let m = Bingham::from_params(&[100.0, 50.0, 0.0, 0.0, 2.0, 0.5, 0.0, 0.0, 0.0, -3.0], 1e-3).unwrap();
-        let y = m.step(&mut (), &Kin::new(0.0, -4.0, 0.0, 2.0));
-        assert!((y - (-(100.0 + 50.0 * 2.0) + (2.0 + 0.5 * 2.0) * -4.0 - 3.0)).abs() < 1e-4);
-        let mut v = [0.0; 10];
-        assert_eq!(m.write_params(&mut v), 10);
-        assert_eq!(Bingham::from_params(&v, 1e-3).unwrap(), m);
-        assert!(Bingham::from_params(&v[..9], 1e-3).is_err());
-        assert!(Bingham::new([-1.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0, 0.0], 0.0, 1e-3).is_err());
-        assert!(Bingham::new([1.0, f32::NAN, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0, 0.0], 0.0, 1e-3).is_err());
-        assert!(Bingham::new([1.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0, 0.0], 0.0, -1.0).is_err());
-    }
-}
+mod tests;

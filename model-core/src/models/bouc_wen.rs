@@ -83,8 +83,13 @@
 //! - general n (SDIRK2): R-RMSE of z 2e-5 (1 Hz) to 6e-4 (9 Hz) at 500 Hz for n = 1.5 and 3.
 
 use crate::error::{check, count, finite, time_step};
-use crate::math::{abs, atan, clamp, expm1, powf, sign, sqrt, tanh};
-use crate::models::lugre::TURN_EPS;
+use crate::math::{abs, clamp, powf, sign};
+use crate::model::write_flat;
+use crate::models::kernels::turning::{turning_point, TURN_EPS};
+use crate::{Finite, Kin, Model, ParamError};
+use region::{region_n1, region_n2, Leg};
+
+mod region;
 
 /// Largest `q·|Δx|` (plus the reversal term) of the short-step path. A zero crossing inside
 /// such a step is off by at most `y²/2` of z* (see the module doc), so 2e-4.
@@ -95,8 +100,6 @@ const FAST_Y: f32 = 0.02;
 fn phi2(y: f32) -> f32 {
     1.0 + y * (-0.5 + y * (1.0 / 6.0))
 }
-use crate::model::write_flat;
-use crate::{Finite, Kin, Model, ParamError};
 
 /// Largest admissible exponent n.
 pub const N_MAX: f32 = 10.0;
@@ -117,21 +120,21 @@ enum Exponent {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoucWen {
     /// Scale α of z (N·m or N per unit z).
-    pub alpha: f32,
+    alpha: f32,
     /// β, multiplies `ẋ·|z|ⁿ`.
-    pub beta: f32,
+    beta: f32,
     /// γ ≥ 0, multiplies `|ẋ|·z·|z|ⁿ⁻¹`.
-    pub gamma: f32,
+    gamma: f32,
     /// δ (Wen's A), the slope dz/dx at z = 0.
-    pub delta: f32,
+    delta: f32,
     /// Exponent n ∈ [1, 10].
-    pub n: f32,
+    n: f32,
     /// Viscous coefficient c (c₀).
-    pub c: f32,
+    c: f32,
     /// Stiffness k (k₀).
-    pub k: f32,
+    k: f32,
     /// Initial displacement x₀ of the spring (0 for the clutch).
-    pub x0: f32,
+    x0: f32,
     dt: f32,
     /// Bound z* of |z|.
     z_max: f32,
@@ -152,6 +155,57 @@ pub struct BoucWen {
     k_x0: f32,
 }
 
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl BoucWen {
+    /// Scale α of z (N·m or N per unit z).
+    #[inline]
+    pub fn alpha(&self) -> f32 {
+        self.alpha
+    }
+
+    /// β, multiplies `ẋ·|z|ⁿ`.
+    #[inline]
+    pub fn beta(&self) -> f32 {
+        self.beta
+    }
+
+    /// γ ≥ 0, multiplies `|ẋ|·z·|z|ⁿ⁻¹`.
+    #[inline]
+    pub fn gamma(&self) -> f32 {
+        self.gamma
+    }
+
+    /// δ (Wen's A), the slope dz/dx at z = 0.
+    #[inline]
+    pub fn delta(&self) -> f32 {
+        self.delta
+    }
+
+    /// Exponent n ∈ [1, 10].
+    #[inline]
+    pub fn n(&self) -> f32 {
+        self.n
+    }
+
+    /// Viscous coefficient c (c₀).
+    #[inline]
+    pub fn c(&self) -> f32 {
+        self.c
+    }
+
+    /// Stiffness k (k₀).
+    #[inline]
+    pub fn k(&self) -> f32 {
+        self.k
+    }
+
+    /// Initial displacement x₀ of the spring (0 for the clutch).
+    #[inline]
+    pub fn x0(&self) -> f32 {
+        self.x0
+    }
+}
+
 /// State: the hysteretic variable and the previous input sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct State {
@@ -169,6 +223,27 @@ pub type Registered = BoucWen;
 
 impl BoucWen {
     /// Build from the paper's parameters (seed 000/001 naming, see the module doc).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::bouc_wen::{BoucWen, SEED000_AVERAGE};
+    /// use model_core::rate::RateParams;
+    /// use model_core::{Estimator, Sample};
+    ///
+    /// let dt = 1e-4; // 10 kHz, as the firmware runs it
+    /// let [alpha, beta, gamma, delta, n, c, k, x0] = SEED000_AVERAGE;
+    /// let model = BoucWen::new(alpha, beta, gamma, delta, n, c, k, x0, dt)?;
+    /// // The firmware's path: raw samples in, the estimator supplies the rates.
+    /// let est = Estimator::new(model, RateParams::kalman(dt, 1e6, 1e-6)?)?;
+    /// let mut state = est.state();
+    /// for i in 0..200 {
+    ///     let b = 1.5 + 1.5 * (core::f32::consts::TAU * 5.0 * i as f32 * dt).sin();
+    ///     let out = est.step(&mut state, Sample::new(b));
+    ///     assert!(out.flags.ok() && out.y.is_finite());
+    /// }
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         alpha: f32,
@@ -386,103 +461,22 @@ impl BoucWen {
     }
 }
 
-/// Result of integrating one sign region.
-enum Leg {
-    /// Stayed in the region; the final |w|.
-    Done(f32),
-    /// Reached w = 0 with this much of the leg left.
-    Crossed(f32),
-}
+/// Seed 000 (Yang & Kermani 2023) Table 3, the five per-frequency fits and their average
+/// (clutch input B, T in N·m), in [`Model::from_params`] order
+/// `alpha, beta, gamma, delta, n, c, k, x0`. Table 3's β and γ are read in Wen's naming
+/// (its β is this γ and its γ this β; see [`BoucWen::new_wen_naming`]), `n = 1`, `x₀ = 0`.
+/// Read as printed, the δ < 0 sets fall outside the bounded class [`BoucWen::new`] accepts.
+pub const SEED000_TABLE3: [(&str, [f32; 8]); 6] = [
+    ("1 Hz", [2.472, 0.062, 1.000, -2.083, 1.0, -0.145, 6.518, 0.0]),
+    ("3 Hz", [2.793, 0.038, 1.000, -1.816, 1.0, -0.084, 6.072, 0.0]),
+    ("5 Hz", [2.441, 0.438, 1.000, -1.523, 1.0, -0.064, 5.826, 0.0]),
+    ("7 Hz", [0.641, 0.847, 1.000, 0.488, 1.0, -0.047, 5.294, 0.0]),
+    ("9 Hz", [2.464, 0.615, 1.000, -2.495, 1.0, -0.045, 5.593, 0.0]),
+    ("average", SEED000_AVERAGE),
+];
 
-/// `dv/dξ = p − q·v` from `v0 ≥ 0` over `l`, stopping at `v = 0` (exact).
-fn region_n1(v0: f32, l: f32, p: f32, q: f32) -> Leg {
-    // v(ξ) = v0 + (p − q v0)·φ(ξ), φ(ξ) = (1 − e^{−qξ})/q.
-    let phi = |x: f32| if q == 0.0 { x } else { -expm1(-q * x) / q };
-    let f0 = p - q * v0;
-    if p < 0.0 && f0 < 0.0 {
-        let phi_star = v0 / -f0;
-        let phi_l = phi(l);
-        if phi_l >= phi_star {
-            let xi = if q == 0.0 { phi_star } else { -libm::log1pf(-q * phi_star) / q };
-            let rem = l - xi;
-            return Leg::Crossed(if rem > 0.0 { rem } else { 0.0 });
-        }
-        let v = v0 + f0 * phi_l;
-        return Leg::Done(if v > 0.0 { v } else { 0.0 });
-    }
-    Leg::Done(v0 + f0 * phi(l))
-}
-
-/// `dv/dξ = p − q·v²` from `v0 ≥ 0` over `l`, stopping at `v = 0` (exact Riccati).
-fn region_n2(v0: f32, l: f32, p: f32, q: f32) -> Leg {
-    if q == 0.0 {
-        let v = v0 + p * l;
-        if p < 0.0 && v <= 0.0 {
-            let rem = l - v0 / -p;
-            return Leg::Crossed(if rem > 0.0 { rem } else { 0.0 });
-        }
-        return Leg::Done(v);
-    }
-    if p > 0.0 {
-        if q > 0.0 {
-            // v = s·tanh(rξ + atanh(v0/s)) in Möbius form (valid for v0 > s too).
-            let s = sqrt(p / q);
-            let t = tanh(sqrt(p * q) * l);
-            return Leg::Done(s * (v0 + s * t) / (s + v0 * t));
-        }
-        // p > 0 > q: finite-distance blow-up; outside the validated class.
-        return Leg::Done(f32::INFINITY);
-    }
-    if q > 0.0 {
-        // dv/dξ = −(|p| + q v²): v = s·tan(atan(v0/s) − rξ).
-        let s = sqrt(-p / q);
-        let r = sqrt(-p * q);
-        let th = atan(v0 / s);
-        let rl = r * l;
-        if rl >= th {
-            let rem = l - th / r;
-            return Leg::Crossed(if rem > 0.0 { rem } else { 0.0 });
-        }
-        let t = libm::tanf(rl);
-        let v = s * (v0 - s * t) / (s + v0 * t);
-        return Leg::Done(if v > 0.0 { v } else { 0.0 });
-    }
-    // p < 0, q < 0: dv/dξ = −|q|(s² − v²), v = s·tanh(atanh(v0/s) − rξ) while v0 < s.
-    let s = sqrt(p / q);
-    if v0 >= s {
-        return Leg::Done(v0);
-    }
-    let r = sqrt(p * q);
-    let u = v0 / s;
-    let t = tanh(r * l);
-    if t >= u {
-        let rem = l - libm::atanhf(u) / r;
-        return Leg::Crossed(if rem > 0.0 { rem } else { 0.0 });
-    }
-    let v = s * (v0 - s * t) / (s - v0 * t);
-    Leg::Done(if v > 0.0 { v } else { 0.0 })
-}
-
-/// The input's extremum inside the step `(t_{k−1}, t_k]`, if `k.dx`, `k.ddx` place one there
-/// and it lies beyond both `x_prev` and `k.x` (see the module doc). Shared with `lugre`.
-#[inline]
-pub(crate) fn turning_point(x_prev: f32, k: &Kin, dt: f32) -> Option<f32> {
-    let (dx, ddx) = (k.dx, k.ddx);
-    if !(dx != 0.0 && ddx != 0.0) {
-        return None;
-    }
-    let tau = dx / ddx;
-    if !(tau > 0.0 && tau < dt) {
-        return None;
-    }
-    let xt = k.x - 0.5 * dx * tau;
-    let s = sign(dx);
-    if (x_prev - xt) * s > 0.0 && (k.x - xt) * s > 0.0 && xt.is_finite() {
-        Some(xt)
-    } else {
-        None
-    }
-}
+/// The average row of [`SEED000_TABLE3`] (Wen's naming, flat order).
+pub const SEED000_AVERAGE: [f32; 8] = [2.162, 0.400, 1.000, -1.486, 1.0, -0.077, 5.861, 0.0];
 
 impl Model for BoucWen {
     type State = State;
@@ -551,323 +545,4 @@ impl BoucWen {
 }
 
 #[cfg(test)]
-mod tests {
-    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
-    use super::*;
-    use std::vec::Vec;
-
-    const DT: f32 = 1.0 / 500.0;
-
-    fn bw(beta: f32, gamma: f32, delta: f32, n: f32) -> BoucWen {
-        BoucWen::new(1.0, beta, gamma, delta, n, 0.0, 0.0, 0.0, DT).unwrap()
-    }
-
-    /// f64 RHS of eq. 2 written directly.
-    fn zdot(m: &BoucWen, z: f64, xd: f64) -> f64 {
-        let (b, g, d, n) = (f64::from(m.beta), f64::from(m.gamma), f64::from(m.delta), f64::from(m.n));
-        d * xd - b * xd * z.abs().powf(n) - g * xd.abs() * z * z.abs().powf(n - 1.0)
-    }
-
-    /// Fine RK4 in f64 of ż along x(t); returns z at each sample.
-    fn rk4_path(m: &BoucWen, x: &dyn Fn(f64) -> (f64, f64), dt: f64, steps: usize, sub: usize) -> Vec<f64> {
-        let mut z = 0.0f64;
-        let mut out = Vec::with_capacity(steps);
-        let h = dt / sub as f64;
-        for i in 0..steps {
-            for j in 0..sub {
-                let t = i as f64 * dt + j as f64 * h;
-                let k1 = zdot(m, z, x(t).1);
-                let k2 = zdot(m, z + 0.5 * h * k1, x(t + 0.5 * h).1);
-                let k3 = zdot(m, z + 0.5 * h * k2, x(t + 0.5 * h).1);
-                let k4 = zdot(m, z + h * k3, x(t + h).1);
-                z += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-            }
-            out.push(z);
-        }
-        out
-    }
-
-    /// Step the f32 model once per sample with the analytic rate; z after each step
-    /// (the first step leaves z at 0 and corresponds to t = 0).
-    fn model_path(m: &BoucWen, x: &dyn Fn(f64) -> (f64, f64, f64), dt: f64, steps: usize) -> Vec<f64> {
-        let first = x(0.0);
-        let k0 = Kin::new(first.0 as f32, first.1 as f32, first.2 as f32, 0.0);
-        let mut s = m.initial_state(&k0);
-        let mut out = Vec::with_capacity(steps);
-        for i in 1..=steps {
-            let (xx, xd, xdd) = x(i as f64 * dt);
-            m.step(&mut s, &Kin::new(xx as f32, xd as f32, xdd as f32, 0.0));
-            out.push(f64::from(s.z));
-        }
-        out
-    }
-
-    fn rel_rms(a: &[f64], b: &[f64]) -> f64 {
-        let num: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum();
-        let den: f64 = a.iter().map(|x| x * x).sum();
-        (num / den).sqrt()
-    }
-
-    fn sine(amp: f64, off: f64, f: f64) -> impl Fn(f64) -> (f64, f64, f64) {
-        let w = 2.0 * core::f64::consts::PI * f;
-        move |t| (off + amp * (w * t).sin(), amp * w * (w * t).cos(), -amp * w * w * (w * t).sin())
-    }
-
-    /// Compare exact/SDIRK core against fine RK4 over `periods` periods of a sine.
-    fn err_vs_rk4(m: &BoucWen, amp: f64, off: f64, f: f64, dt: f64, periods: f64) -> f64 {
-        let x = sine(amp, off, f);
-        let steps = (periods / f / dt).round() as usize;
-        let refz = rk4_path(m, &|t| (x(t).0, x(t).1), dt, steps, 400);
-        let got = model_path(m, &x, dt, steps);
-        let e = rel_rms(&refz, &got);
-        std::eprintln!("err n={} f={f} dt={dt}: {e:.3e}", m.n);
-        e
-    }
-
-    #[test]
-    fn equation_value_hand_computed() {
-        // One tiny step from z = 0.5: dz ≈ ż·Δt with ż from eq. 2 by hand.
-        let m = BoucWen::new(2.0, 0.3, 0.7, 1.5, 1.0, 0.1, 4.0, 0.25, DT).unwrap();
-        let mut s = State { z: 0.5, x_prev: 1.0 };
-        let dx = 1.0e-3f32;
-        let y = m.step(&mut s, &Kin::new(1.0 + dx, 2.0, 0.0, 0.0));
-        // ẋ > 0, z > 0: dz/dx = δ − (β+γ)·z = 1.5 − 1.0·0.5 = 1.0
-        assert!((s.z - (0.5 + 1.0e-3)).abs() < 2e-6, "{}", s.z);
-        // T = c·ẋ + k·(x − x0) + α·z
-        let want = 0.1 * 2.0 + 4.0 * (1.001 - 0.25) + 2.0 * s.z;
-        assert!((y - want).abs() < 1e-5);
-        // ẋ < 0, z > 0: dz/dx = δ − (β − γ)·z = 1.5 + 0.4·z
-        let mut s = State { z: 0.5, x_prev: 1.0 };
-        m.step(&mut s, &Kin::new(1.0 - dx, -2.0, 0.0, 0.0));
-        assert!((s.z - (0.5 - 1.7e-3)).abs() < 2e-6, "{}", s.z);
-    }
-
-    #[test]
-    fn saturates_at_bound() {
-        // Long monotone travel ends at the equilibrium sgn(δ)·z*.
-        for (b, g, d, n) in [
-            (0.5, 0.5, 2.0, 1.0),
-            (0.2, 0.9, 3.0, 2.0),
-            (0.3, 0.6, 1.0, 3.5),
-            (0.4, 1.0, -1.5, 1.0),
-            (-0.5, 1.0, -2.0, 2.0),
-        ] {
-            let m = bw(b, g, d, n);
-            let zs =
-                (f64::from(d).abs() / (f64::from(g) + f64::from(d).signum() * f64::from(b))).powf(1.0 / f64::from(n));
-            assert!((f64::from(m.z_bound()) - zs).abs() < 1e-5 * zs);
-            let mut s = State::default();
-            for i in 1..=2000 {
-                m.step(&mut s, &Kin::new(i as f32 * 0.01, 5.0, 0.0, 0.0));
-            }
-            let want = f64::from(d).signum() * zs;
-            assert!((f64::from(s.z) - want).abs() < 1e-4 * zs, "n={n} z={} want {want}", s.z);
-        }
-    }
-
-    #[test]
-    fn exact_n1_matches_rk4() {
-        // seed 000 Table 3 average read in Wen's naming (bounded), and the 7 Hz set as printed.
-        let sets = [
-            BoucWen::new_wen_naming(2.162, -1.486, 1.0, 0.400, 1.0, -0.077, 5.861, 0.0, DT).unwrap(),
-            BoucWen::new(0.641, 1.0, 0.847, 0.488, 1.0, -0.047, 5.294, 0.0, DT).unwrap(),
-            bw(-0.3, 0.8, 2.5, 1.0),
-        ];
-        for m in &sets {
-            for f in [1.0, 5.0, 9.0] {
-                let e = err_vs_rk4(m, 1.5, 1.5, f, f64::from(DT), 3.0);
-                assert!(e < 1e-4, "n=1 f={f}: {e}");
-            }
-        }
-    }
-
-    #[test]
-    fn exact_n2_matches_rk4() {
-        // Seed 003 damper set (x in mm), Wen's naming: A = 30.852, β = 0.081, γ = 1.507.
-        let m = BoucWen::new_wen_naming(173.27, 30.852, 0.081, 1.507, 2.0, 8.907, 1.984, -20.161, DT).unwrap();
-        let others = [bw(0.6, 0.3, 2.0, 2.0), bw(-0.5, 1.0, -2.0, 2.0), bw(0.3, 0.8, -1.0, 2.0)];
-        for f in [1.0, 5.0, 9.0] {
-            let e = err_vs_rk4(&m, 4.0, 0.0, f, f64::from(DT), 3.0);
-            assert!(e < 1e-4, "seed003 f={f}: {e}");
-        }
-        for m in &others {
-            for f in [1.0, 9.0] {
-                let e = err_vs_rk4(m, 1.5, 0.3, f, f64::from(DT), 3.0);
-                assert!(e < 1e-4, "n=2 {m:?} f={f}: {e}");
-            }
-        }
-    }
-
-    #[test]
-    fn general_n_sdirk_accuracy() {
-        for n in [1.5f32, 3.0] {
-            let m = bw(0.5, 0.5, 2.0, n);
-            for f in [1.0, 9.0] {
-                let e = err_vs_rk4(&m, 1.5, 0.0, f, f64::from(DT), 3.0);
-                assert!(e < 2e-3, "n={n} f={f}: {e}");
-            }
-        }
-    }
-
-    #[test]
-    fn general_path_agrees_with_exact_for_n2() {
-        // Force the SDIRK path on n = 2 and compare with the exact Riccati update.
-        let mut g = bw(0.6, 0.3, 2.0, 2.0);
-        let exact = g;
-        g.exp = Exponent::General;
-        let x = sine(1.5, 0.0, 5.0);
-        let a = model_path(&exact, &x, 1.0 / 3000.0, 1800);
-        let b = model_path(&g, &x, 1.0 / 3000.0, 1800);
-        assert!(rel_rms(&a, &b) < 1e-3, "{}", rel_rms(&a, &b));
-    }
-
-    #[test]
-    fn zero_crossing_split_is_exact() {
-        // One big step from z = −z* upward: compare with many tiny steps.
-        let m = bw(0.2, 0.8, 2.0, 1.0);
-        let zs = m.z_bound();
-        let mut big = State { z: -zs, x_prev: 0.0 };
-        m.step(&mut big, &Kin::new(1.3, 1.0, 0.0, 0.0));
-        let mut fine = State { z: -zs, x_prev: 0.0 };
-        for i in 1..=100_000 {
-            m.step(&mut fine, &Kin::new(1.3 * i as f32 / 100_000.0, 1.0, 0.0, 0.0));
-        }
-        assert!((big.z - fine.z).abs() < 1e-4, "{} vs {}", big.z, fine.z);
-    }
-
-    #[test]
-    fn reversal_split_uses_turning_point() {
-        // x goes 0 → 1 → 0.9 within one step; with the turning point the result equals
-        // two explicit steps through x = 1.
-        let m = bw(0.5, 0.5, 2.0, 1.0);
-        let mut two = State { z: 0.0, x_prev: 0.0 };
-        m.step(&mut two, &Kin::new(1.0, 0.0, 0.0, 0.0));
-        m.step(&mut two, &Kin::new(0.9, 0.0, 0.0, 0.0));
-        // Quadratic ending at 0.9 with extremum 1.0 at τ = 0.5·dt before the sample.
-        let tau = 0.5 * DT;
-        let ddx = -2.0 * 0.1 / (tau * tau);
-        let dx = ddx * tau;
-        let mut one = State { z: 0.0, x_prev: 0.0 };
-        m.step(&mut one, &Kin::new(0.9, dx, ddx, 0.0));
-        assert!((one.z - two.z).abs() < 1e-4, "{} vs {}", one.z, two.z);
-    }
-
-    /// Loop of the hysteretic part z(x) over one period after transients.
-    fn z_loop(m: &BoucWen, amp: f32) -> (f64, f64, f64) {
-        let n = 400;
-        let mut s = State::default();
-        let w = 2.0 * core::f32::consts::PI / n as f32;
-        let (mut pts, mut slope0) = (Vec::new(), 0.0f64);
-        for i in 0..(4 * n) {
-            let x = amp * (w * i as f32).sin();
-            m.step(&mut s, &Kin::new(x, 0.0, 0.0, 0.0));
-            if i >= 3 * n {
-                pts.push((f64::from(x), f64::from(s.z)));
-            }
-        }
-        // shoelace area, height (max z), slope at z ≈ 0 while loading
-        let mut area = 0.0;
-        for i in 0..pts.len() {
-            let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
-            area += a.0 * b.1 - b.0 * a.1;
-        }
-        let hmax = pts.iter().map(|p| p.1).fold(f64::MIN, f64::max);
-        for i in 1..pts.len() {
-            let (a, b) = (pts[i - 1], pts[i]);
-            if b.0 > a.0 && a.1 <= 0.0 && b.1 > 0.0 {
-                slope0 = (b.1 - a.1) / (b.0 - a.0);
-            }
-        }
-        (0.5 * area.abs(), hmax, slope0)
-    }
-
-    #[test]
-    fn seed003_influence_of_a() {
-        // Seed 003 Fig. 7 (β = 0.5, γ = −0.4 in its naming, n = 1): a larger A gives a
-        // larger loop and a steeper slope at z = 0 (which equals A, Table 4).
-        let mut prev = (0.0, 0.0, 0.0);
-        for a in [0.5f32, 1.0, 2.0, 4.0] {
-            let m = BoucWen::new_wen_naming(1.0, a, 0.5, -0.4, 1.0, 0.0, 0.0, 0.0, DT).unwrap();
-            let l = z_loop(&m, 2.0);
-            assert!(l.0 > prev.0 && l.1 > prev.1 && l.2 > prev.2, "A={a}: {l:?} after {prev:?}");
-            assert!((l.2 - f64::from(a)).abs() < 0.05 * f64::from(a), "slope at z=0 {} vs A {a}", l.2);
-            prev = l;
-        }
-    }
-
-    #[test]
-    fn seed003_table4_slopes() {
-        // Table 4 (Wen's naming): dz/dx = A − (γ + β·sgn(ẋ z))|z|ⁿ.
-        let (a, bw_, gw, n) = (1.0f32, 0.5f32, 0.2f32, 2.0f32);
-        let m = BoucWen::new_wen_naming(1.0, a, bw_, gw, n, 0.0, 0.0, 0.0, DT).unwrap();
-        let h = 1e-4f32;
-        for (z, dir) in [(0.6f32, 1.0f32), (0.6, -1.0), (-0.6, 1.0), (-0.6, -1.0)] {
-            let mut s = State { z, x_prev: 0.0 };
-            m.step(&mut s, &Kin::new(dir * h, 0.0, 0.0, 0.0));
-            let slope = (s.z - z) / (dir * h);
-            let want = a - (gw + bw_ * (dir * z).signum()) * z.abs().powf(n);
-            assert!((slope - want).abs() < 2e-2, "z={z} dir={dir}: {slope} vs {want}");
-        }
-    }
-
-    #[test]
-    fn seed003_influence_of_n_and_beta_gamma() {
-        // Larger n: sharper transition → the loop approaches the elasto-plastic
-        // rectangle, so its area grows with n (seed 003 Fig. 8), saturating beyond n ≈ 2.
-        let mut prev = 0.0;
-        let mut areas = Vec::new();
-        for n in [1.0f32, 1.5, 2.0, 3.0, 5.0] {
-            let m = BoucWen::new_wen_naming(1.0, 1.0, 0.5, 0.5, n, 0.0, 0.0, 0.0, DT).unwrap();
-            let l = z_loop(&m, 3.0);
-            assert!(l.0 > prev, "n={n}: area {} after {prev}", l.0);
-            prev = l.0;
-            areas.push(l.0);
-        }
-        assert!(areas[1] - areas[0] > areas[4] - areas[3], "n effect should fade beyond 2: {areas:?}");
-        // Seed 003 Fig. 12: β + γ constant (0.8/0.2 vs 0.5/0.5) → nearly the same loop.
-        let a = z_loop(&BoucWen::new_wen_naming(1.0, 1.0, 0.8, 0.2, 1.0, 0.0, 0.0, 0.0, DT).unwrap(), 2.0);
-        let b = z_loop(&BoucWen::new_wen_naming(1.0, 1.0, 0.5, 0.5, 1.0, 0.0, 0.0, 0.0, DT).unwrap(), 2.0);
-        assert!((a.1 - b.1).abs() < 0.05 * b.1, "heights {} {}", a.1, b.1);
-        // Seed 003 Fig. 10: increasing γ (Wen's, on ẋ|z|ⁿ) flattens the loop: lower height.
-        let mut prev_h = f64::MAX;
-        for gw in [-0.3f32, 0.0, 0.3, 0.9] {
-            let l = z_loop(&BoucWen::new_wen_naming(1.0, 1.0, 0.5, gw, 1.0, 0.0, 0.0, 0.0, DT).unwrap(), 2.0);
-            assert!(l.1 < prev_h, "γ={gw}: height {} after {prev_h}", l.1);
-            prev_h = l.1;
-        }
-        // Seed 003 Table 5 / Fig. 9: β (Wen's) controls the stiffness change at reversal:
-        // β = 0 → same |slope| on loading and unloading at given |z|; β > 0 softening
-        // (unloading steeper than loading, since dz/dx = A − (γ ± β)|z|ⁿ).
-        let m = BoucWen::new_wen_naming(1.0, 1.0, 0.6, 0.2, 1.0, 0.0, 0.0, 0.0, DT).unwrap();
-        let h = 1e-4f32;
-        let mut up = State { z: 0.5, x_prev: 0.0 };
-        m.step(&mut up, &Kin::new(h, 0.0, 0.0, 0.0));
-        let mut dn = State { z: 0.5, x_prev: 0.0 };
-        m.step(&mut dn, &Kin::new(-h, 0.0, 0.0, 0.0));
-        assert!((0.5 - dn.z) > (up.z - 0.5), "unloading slope must exceed loading slope");
-    }
-
-    #[test]
-    fn rejects_invalid() {
-        assert!(BoucWen::new(1.0, 1.0, -0.1, 1.0, 1.0, 0.0, 0.0, 0.0, DT).is_err()); // γ < 0
-        assert!(BoucWen::new(1.0, -1.0, 0.5, 1.0, 1.0, 0.0, 0.0, 0.0, DT).is_err()); // γ+β ≤ 0
-        assert!(BoucWen::new(1.0, 1.0, 0.4, -1.486, 1.0, 0.0, 0.0, 0.0, DT).is_err()); // Table 3 as printed
-        assert!(BoucWen::new(1.0, 0.4, 1.0, -1.486, 1.0, 0.0, 0.0, 0.0, DT).is_ok()); // swapped
-        assert!(BoucWen::new(1.0, 1.0, 1.0, 1.0, 0.5, 0.0, 0.0, 0.0, DT).is_err()); // n < 1
-        assert!(BoucWen::new(1.0, 1.0, 1.0, 1.0, 11.0, 0.0, 0.0, 0.0, DT).is_err()); // n > 10
-        assert!(BoucWen::new(f32::NAN, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, DT).is_err());
-        assert!(BoucWen::new(1.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0).is_err());
-        assert!(BoucWen::new(1.0, 1.0e-12, 0.0, 1.0e6, 1.0, 0.0, 0.0, 0.0, DT).is_err()); // z* huge
-        assert!(BoucWen::from_params(&[1.0; 7], DT).is_err());
-    }
-
-    #[test]
-    fn round_trip() {
-        // δ < 0 needs γ − β > 0.
-        let p = [2.0, 0.2, 0.7, -1.5, 1.7, 0.1, 4.0, 0.25];
-        let m = BoucWen::from_params(&p, DT).unwrap();
-        let mut out = [0.0; 8];
-        assert_eq!(m.write_params(&mut out), 8);
-        assert_eq!(out, p);
-    }
-}
+mod tests;

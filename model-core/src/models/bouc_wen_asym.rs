@@ -51,9 +51,14 @@
 //! 1–9 Hz of this project).
 
 use crate::error::{check, count, finite, time_step};
-use crate::math::{abs, atan, clamp, expm1, ln, powf, sign, sin, sqrt, tanh};
+use crate::math::{abs, clamp, powf, sign, sqrt, tanh};
 use crate::model::write_flat;
 use crate::{Finite, Kin, Model, ParamError};
+use flow::Fall;
+pub use steady::{Branches, LOOP_POINTS};
+
+mod flow;
+mod steady;
 
 /// Which asymmetry function ψ (flat parameter `variant`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -123,30 +128,105 @@ struct Derived {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BoucWenAsym {
     /// Linear/hysteretic split α ∈ [0, 1].
-    pub alpha: f32,
+    alpha: f32,
     /// Output scale κ > 0.
-    pub kappa: f32,
+    kappa: f32,
     /// D > 0.
-    pub d: f32,
+    d: f32,
     /// A ≠ 0.
-    pub a: f32,
+    a: f32,
     /// β ≥ 0.
-    pub beta: f32,
+    beta: f32,
     /// γ (β + γ·sgn(A) > 0).
-    pub gamma: f32,
+    gamma: f32,
     /// Exponent n ∈ [1, 8].
-    pub n: f32,
+    n: f32,
     /// Initial hysteretic state z(0).
-    pub z0: f32,
+    z0: f32,
     /// Asymmetry gain δ.
-    pub delta: f32,
+    delta: f32,
     /// Sigmoid rate p ≥ 0 (eq. 31 only).
-    pub p: f32,
+    p: f32,
     /// Sigmoid centre q (eq. 31 only).
-    pub q: f32,
-    pub asymmetry: Asymmetry,
+    q: f32,
+    asymmetry: Asymmetry,
     k: Derived,
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl BoucWenAsym {
+    /// Linear/hysteretic split α ∈ [0, 1].
+    #[inline]
+    pub fn alpha(&self) -> f32 {
+        self.alpha
+    }
+
+    /// Output scale κ > 0.
+    #[inline]
+    pub fn kappa(&self) -> f32 {
+        self.kappa
+    }
+
+    /// D > 0.
+    #[inline]
+    pub fn d(&self) -> f32 {
+        self.d
+    }
+
+    /// A ≠ 0.
+    #[inline]
+    pub fn a(&self) -> f32 {
+        self.a
+    }
+
+    /// β ≥ 0.
+    #[inline]
+    pub fn beta(&self) -> f32 {
+        self.beta
+    }
+
+    /// γ (β + γ·sgn(A) > 0).
+    #[inline]
+    pub fn gamma(&self) -> f32 {
+        self.gamma
+    }
+
+    /// Exponent n ∈ [1, 8].
+    #[inline]
+    pub fn n(&self) -> f32 {
+        self.n
+    }
+
+    /// Initial hysteretic state z(0).
+    #[inline]
+    pub fn z0(&self) -> f32 {
+        self.z0
+    }
+
+    /// Asymmetry gain δ.
+    #[inline]
+    pub fn delta(&self) -> f32 {
+        self.delta
+    }
+
+    /// Sigmoid rate p ≥ 0 (eq. 31 only).
+    #[inline]
+    pub fn p(&self) -> f32 {
+        self.p
+    }
+
+    /// Sigmoid centre q (eq. 31 only).
+    #[inline]
+    pub fn q(&self) -> f32 {
+        self.q
+    }
+
+    /// Which asymmetry function ψ (flat parameter `variant`).
+    #[inline]
+    pub fn asymmetry(&self) -> Asymmetry {
+        self.asymmetry
+    }
 }
 
 /// Hysteretic state z, the previous input, and whether a first sample was seen.
@@ -165,34 +245,22 @@ impl Finite for State {
 
 pub type Registered = BoucWenAsym;
 
-/// Result of the unloading-region flow.
-enum Fall {
-    /// Stayed in the region, at this |z|.
-    Stopped(f32),
-    /// Reached z = 0 with this much path length left.
-    Crossed(f32),
-}
-
-/// `−ln(1 − r)` for `r ≤ 1`, accurate for small |r|.
-fn neg_ln1m(r: f32) -> f32 {
-    if abs(r) < 1e-3 {
-        r * (1.0 + r * (0.5 + r * (1.0 / 3.0)))
-    } else {
-        -ln(1.0 - r)
-    }
-}
-
-/// `atanh(r)` for `0 ≤ r ≤ 1`.
-fn atanh(r: f32) -> f32 {
-    if r < 1e-3 {
-        r * (1.0 + r * r * (1.0 / 3.0))
-    } else {
-        0.5 * ln((1.0 + r) / (1.0 - r))
-    }
-}
-
 impl BoucWenAsym {
     /// Paper form (seed 004 Tables A17–A18 order). Bounds: see the module docs.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::bouc_wen_asym::{Asymmetry, BoucWenAsym, SEED004_A17};
+    /// use model_core::{Kin, Model};
+    ///
+    /// let [alpha, kappa, d, a, beta, gamma, n, z0, delta, p, q, _variant] = SEED004_A17;
+    /// let model = BoucWenAsym::new(alpha, kappa, d, a, beta, gamma, n, z0, delta, p, q, Asymmetry::Linear, 1e-3)?;
+    /// let mut state = model.initial_state(&Kin::new(0.5, 0.0, 0.0, 0.0));
+    /// let y = model.step(&mut state, &Kin::new(0.51, 10.0, 0.0, 0.0));
+    /// assert!(y.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         alpha: f32,
@@ -296,112 +364,6 @@ impl BoucWenAsym {
         }
     }
 
-    /// Secant rate of the loading flow about z̄.
-    #[inline]
-    fn lam_rise(&self, u: f32) -> f32 {
-        let k = &self.k;
-        let dz = u - k.zbar;
-        if abs(dz) <= 1e-4 * k.zbar {
-            k.lam1_eq
-        } else {
-            (k.aa - k.c1 * powf(u, self.n)) / dz
-        }
-    }
-
-    /// Secant rate of the unloading flow about its fixed point e₂.
-    #[inline]
-    fn lam_fall(&self, v: f32) -> f32 {
-        let k = &self.k;
-        let dv = v - k.e2;
-        if abs(dv) <= 1e-4 * abs(k.e2) {
-            k.lam2_eq
-        } else {
-            (-k.aa + k.c2 * powf(v, self.n)) / dv
-        }
-    }
-
-    /// Loading region: `du/dσ = |A| − c₁·uⁿ`, `u ≥ 0`, over path length `h`.
-    #[inline]
-    fn rise(&self, u0: f32, h: f32) -> f32 {
-        let k = &self.k;
-        match k.order {
-            Order::One => u0 + (u0 - k.zbar) * expm1(-k.c1 * h),
-            Order::Two => {
-                let t = tanh(k.om1 * h);
-                k.zbar * (u0 + k.zbar * t) / (k.zbar + u0 * t)
-            }
-            Order::General => {
-                let pred = u0 + (u0 - k.zbar) * expm1(self.lam_rise(u0) * h);
-                let mid = 0.5 * (u0 + pred);
-                let pred = u0 + (u0 - k.zbar) * expm1(self.lam_rise(mid) * h);
-                let mid = 0.5 * (u0 + pred);
-                u0 + (u0 - k.zbar) * expm1(self.lam_rise(mid) * h)
-            }
-        }
-    }
-
-    /// Unloading region: `dv/dσ = −|A| + c₂·vⁿ`, `v > 0`, until v = 0.
-    #[inline]
-    fn fall(&self, v0: f32, h: f32) -> Fall {
-        let k = &self.k;
-        let done = |s_star: f32, stop: f32| {
-            if s_star <= h {
-                Fall::Crossed(h - s_star)
-            } else {
-                Fall::Stopped(stop.max(0.0))
-            }
-        };
-        if k.c2 == 0.0 {
-            return done(v0 / k.aa, v0 - k.aa * h);
-        }
-        if k.c2 > 0.0 && v0 >= k.e2 {
-            // At the unstable fixed point z_run (only reachable through the clamp).
-            return Fall::Stopped(v0);
-        }
-        match k.order {
-            Order::One => {
-                let s_star = neg_ln1m(v0 / k.e2) / k.c2;
-                if s_star <= h {
-                    Fall::Crossed(h - s_star)
-                } else {
-                    Fall::Stopped((v0 + (v0 - k.e2) * expm1(k.c2 * h)).max(0.0))
-                }
-            }
-            Order::Two => {
-                let e = abs(k.e2);
-                if k.c2 > 0.0 {
-                    let s_star = atanh(v0 / e) / k.om2;
-                    if s_star <= h {
-                        Fall::Crossed(h - s_star)
-                    } else {
-                        let t = tanh(k.om2 * h);
-                        Fall::Stopped((e * (v0 - e * t) / (e - v0 * t)).max(0.0))
-                    }
-                } else {
-                    let th0 = atan(v0 / e);
-                    let s_star = th0 / k.om2;
-                    if s_star <= h {
-                        Fall::Crossed(h - s_star)
-                    } else {
-                        let th = th0 - k.om2 * h;
-                        Fall::Stopped((e * sin(th) / sin(core::f32::consts::FRAC_PI_2 - th)).max(0.0))
-                    }
-                }
-            }
-            Order::General => {
-                let s_star = neg_ln1m(v0 / k.e2) / self.lam_fall(0.5 * v0);
-                if s_star <= h {
-                    return Fall::Crossed(h - s_star);
-                }
-                let pred = (v0 + (v0 - k.e2) * expm1(self.lam_fall(v0) * h)).max(0.0);
-                let mid = 0.5 * (v0 + pred);
-                let pred = (v0 + (v0 - k.e2) * expm1(self.lam_fall(mid) * h)).max(0.0);
-                let mid = 0.5 * (v0 + pred);
-                Fall::Stopped((v0 + (v0 - k.e2) * expm1(self.lam_fall(mid) * h)).max(0.0))
-            }
-        }
-    }
-
     /// Add `g·ψ` to w and clamp (a NaN increment — 0·∞ — is ignored).
     #[inline]
     fn force(&self, w: f32, g: f32, x: f32, s: f32) -> f32 {
@@ -415,7 +377,7 @@ impl BoucWenAsym {
 
     /// Advance z from input `x0` to `x1` over `t` seconds (see the module docs).
     #[inline]
-    fn advance(&self, z: f32, x0: f32, x1: f32, t: f32) -> f32 {
+    pub(super) fn advance(&self, z: f32, x0: f32, x1: f32, t: f32) -> f32 {
         let k = &self.k;
         let dx = x1 - x0;
         let s = sign(dx);
@@ -438,81 +400,20 @@ impl BoucWenAsym {
         w = self.force(w, g, x1, s);
         k.sa * w
     }
-
-    /// The steady loop for a triangular input between `x_lo` and `x_hi` at the constant
-    /// rate `rate` (unit of x per second): z on the rising branch and on the falling
-    /// branch at the `LOOP_POINTS + 1` inputs `x_lo + i·(x_hi − x_lo)/LOOP_POINTS`, after
-    /// eight settling cycles from z(0). `None` for invalid arguments.
-    pub fn steady_loop(&self, x_lo: f32, x_hi: f32, rate: f32) -> Option<Branches> {
-        const M: usize = LOOP_POINTS;
-        if !(x_lo.is_finite() && x_hi.is_finite() && x_hi > x_lo && rate.is_finite() && rate > 0.0) {
-            return None;
-        }
-        let step = (x_hi - x_lo) / M as f32;
-        let t = step / rate;
-        if !(t.is_finite() && t > 0.0) {
-            return None;
-        }
-        let xi = |i: usize| x_lo + step * i as f32;
-        let mut z = self.z0;
-        for _ in 0..8 {
-            for i in 1..=M {
-                z = self.advance(z, xi(i - 1), xi(i), t);
-            }
-            for i in (0..M).rev() {
-                z = self.advance(z, xi(i + 1), xi(i), t);
-            }
-        }
-        let mut b = Branches { up: [0.0; M + 1], down: [0.0; M + 1] };
-        for (i, u) in b.up.iter_mut().enumerate() {
-            if i > 0 {
-                z = self.advance(z, xi(i - 1), xi(i), t);
-            }
-            *u = z;
-        }
-        for (i, dn) in b.down.iter_mut().enumerate().rev() {
-            if i < M {
-                z = self.advance(z, xi(i + 1), xi(i), t);
-            }
-            *dn = z;
-        }
-        Some(b)
-    }
-
-    /// Whether the loading and unloading branches of the steady loop cross.
-    ///
-    /// Seed 004 §6.2 reports that eq. 30 can produce non-physical crossing loops: the
-    /// asymmetry term opposes (δ·A < 0) or reinforces the Bouc–Wen loop in proportion to
-    /// x and to the time spent, so at some excitation rates it turns the loop round
-    /// near the upper end of the range only, and the branches cross. The loop is traced
-    /// by [`BoucWenAsym::steady_loop`] for a triangular input between `x_lo` and `x_hi` at
-    /// the constant rate `rate` (unit of x per second; the answer depends on it — seed
-    /// 004's excitation is 0.05 Hz over the normalised range, rate 0.1 s⁻¹). The branches
-    /// cross when `z_down − z_up` takes both signs, each by more than 0.1 % of its largest
-    /// magnitude, at interior points. Invalid arguments give `false`.
-    pub fn crossing_risk(&self, x_lo: f32, x_hi: f32, rate: f32) -> bool {
-        let Some(b) = self.steady_loop(x_lo, x_hi, rate) else { return false };
-        let mut lo = 0.0f32;
-        let mut hi = 0.0f32;
-        for (u, dn) in b.up.iter().zip(b.down.iter()).skip(1).take(LOOP_POINTS - 1) {
-            let diff = dn - u;
-            lo = lo.min(diff);
-            hi = hi.max(diff);
-        }
-        let tol = 1e-3 * hi.max(-lo);
-        tol > 0.0 && hi > tol && lo < -tol
-    }
 }
 
-/// Intervals per branch of [`BoucWenAsym::steady_loop`].
-pub const LOOP_POINTS: usize = 256;
-
-/// Rising and falling branch of a steady loop (z at equally spaced inputs).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Branches {
-    pub up: [f32; LOOP_POINTS + 1],
-    pub down: [f32; LOOP_POINTS + 1],
-}
+/// Seed 004 (de la Morena et al. 2025) Table A17, ABW₁ (eq. 30), in [`Model::from_params`]
+/// order. The tables' minus signs did not survive the text of the paper: the values are
+/// as printed (all positive), which puts them in the bounded class [`BoucWenAsym::new`]
+/// accepts. Input and output normalised to 0…1.
+pub const SEED004_A17: [f32; 12] =
+    [0.6424, 1.5240, 1.7321, 0.7691, 16.9435, 22.2617, 1.0026, 0.0884, 0.0042, 0.0, 0.0, 1.0];
+/// Seed 004 Table A18, ABW₂ (eq. 31), signs as printed (see [`SEED004_A17`]).
+pub const SEED004_A18: [f32; 12] =
+    [0.1426, 2.3705, 3.2796, 0.1191, 1.1090, 2.5201, 1.5, 0.0086, 0.1510, 0.0064, 0.2509, 2.0];
+/// Seed 004 Table A16, the classical Bouc–Wen model (eq. 26 = eq. 28 with δ = 0, n = 1),
+/// signs as printed (see [`SEED004_A17`]).
+pub const SEED004_A16: [f32; 12] = [0.8034, 1.1519, 3.8950, 3.4516, 59.7669, 50.0, 1.0, 0.0961, 0.0, 0.0, 0.0, 1.0];
 
 impl Model for BoucWenAsym {
     type State = State;
@@ -575,280 +476,4 @@ impl Model for BoucWenAsym {
 }
 
 #[cfg(test)]
-mod tests {
-    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
-    use super::*;
-
-    fn kin(x: f32) -> Kin {
-        Kin::new(x, 0.0, 0.0, 0.0)
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn abw(
-        d: f32,
-        a: f32,
-        beta: f32,
-        gamma: f32,
-        n: f32,
-        z0: f32,
-        delta: f32,
-        p: f32,
-        q: f32,
-        v: Asymmetry,
-        dt: f32,
-    ) -> BoucWenAsym {
-        BoucWenAsym::new(0.5, 1.0, d, a, beta, gamma, n, z0, delta, p, q, v, dt).unwrap()
-    }
-
-    /// Seed 004 Table A17 (ABW₁, eq. 30), signs as printed.
-    pub(crate) const A17: [f32; 12] =
-        [0.6424, 1.5240, 1.7321, 0.7691, 16.9435, 22.2617, 1.0026, 0.0884, 0.0042, 0.0, 0.0, 1.0];
-    /// Seed 004 Table A18 (ABW₂, eq. 31), signs as printed.
-    pub(crate) const A18: [f32; 12] =
-        [0.1426, 2.3705, 3.2796, 0.1191, 1.1090, 2.5201, 1.5, 0.0086, 0.1510, 0.0064, 0.2509, 2.0];
-
-    /// Monotone loading from z = 0 for n = 1: `z(x) = z̄·(1 − e^{−c₁x/D})` (eq. 26
-    /// integrated by hand), whatever the step size.
-    #[test]
-    fn n1_loading_is_exact() {
-        let (d, a, b, g) = (2.0f32, 1.5f32, 0.7f32, 0.3f32);
-        let m = abw(d, a, b, g, 1.0, 0.0, 0.0, 0.0, 0.0, Asymmetry::Linear, 1e-3);
-        let mut s = m.initial_state(&kin(0.0));
-        m.step(&mut s, &kin(0.0));
-        for (i, x) in [0.05f32, 0.3, 0.31, 1.0, 2.5].iter().enumerate() {
-            let y = m.step(&mut s, &kin(*x));
-            let zbar = f64::from(a / (b + g));
-            let want_z = zbar * (1.0 - (-(f64::from(b + g)) * f64::from(*x) / f64::from(d)).exp());
-            assert!((f64::from(s.z) - want_z).abs() < 2e-6, "step {i}: z {} vs {want_z}", s.z);
-            let want_y = 0.5 * f64::from(*x) + 0.5 * f64::from(d) * want_z;
-            assert!((f64::from(y) - want_y).abs() < 1e-5);
-        }
-    }
-
-    /// n = 2, monotone loading from 0: `z = z̄·tanh(√(A(β+γ))·x/D)`.
-    #[test]
-    fn n2_loading_is_exact() {
-        let (d, a, b, g) = (1.5f32, 2.0f32, 1.0f32, 3.0f32);
-        let m = abw(d, a, b, g, 2.0, 0.0, 0.0, 0.0, 0.0, Asymmetry::Linear, 1e-3);
-        let mut s = m.initial_state(&kin(0.0));
-        m.step(&mut s, &kin(0.0));
-        for x in [0.1f32, 0.15, 0.6, 2.0] {
-            m.step(&mut s, &kin(x));
-            let (a, c) = (f64::from(a), f64::from(b + g));
-            let want = (a / c).sqrt() * ((a * c).sqrt() * f64::from(x) / f64::from(d)).tanh();
-            assert!((f64::from(s.z) - want).abs() < 2e-6, "x={x}: {} vs {want}", s.z);
-        }
-    }
-
-    /// Independent f64 reference: eq. 28 with RK4, `sub` substeps per sample, on the
-    /// analytic input `x(t)`, `ẋ(t)`.
-    fn rk4_reference(pr: &[f32; 12], x: &dyn Fn(f64) -> (f64, f64), fs: f64, samples: usize, sub: usize) -> Vec<f64> {
-        let p: Vec<f64> = pr.iter().map(|v| f64::from(*v)).collect();
-        let (alpha, kappa, d, a, beta, gamma, n, z0, delta, pp, q) =
-            (p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], p[9], p[10]);
-        let variant = pr[11];
-        let rhs = |z: f64, t: f64| {
-            let (xv, xd) = x(t);
-            let sg = if xd > 0.0 {
-                1.0
-            } else if xd < 0.0 {
-                -1.0
-            } else {
-                0.0
-            };
-            let psi = if variant == 1.0 {
-                delta * xv * sg
-            } else {
-                delta * (1.0 + sg) * (1.0 / (1.0 + (-pp * (xv - q)).exp()) - 0.5)
-            };
-            (a * xd - beta * xd.abs() * z.abs().powf(n - 1.0) * z - gamma * xd * z.abs().powf(n) + psi) / d
-        };
-        let h = 1.0 / (fs * sub as f64);
-        let mut z = z0;
-        let mut out = Vec::with_capacity(samples);
-        for k in 0..samples {
-            let t0 = k as f64 / fs;
-            out.push(alpha * kappa * x(t0).0 + (1.0 - alpha) * d * kappa * z);
-            for j in 0..sub {
-                let t = t0 + j as f64 * h;
-                let k1 = rhs(z, t);
-                let k2 = rhs(z + 0.5 * h * k1, t + 0.5 * h);
-                let k3 = rhs(z + 0.5 * h * k2, t + 0.5 * h);
-                let k4 = rhs(z + h * k3, t + h);
-                z += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-            }
-        }
-        out
-    }
-
-    /// R-RMSE (seed 000 eq. 20) of the f32 model stepped once per sample.
-    fn r_rmse(pr: &[f32; 12], x: &dyn Fn(f64) -> (f64, f64), fs: f64, samples: usize) -> f64 {
-        let reference = rk4_reference(pr, x, fs, samples, 200);
-        let m = BoucWenAsym::from_params(pr, (1.0 / fs) as f32).unwrap();
-        let mut s = m.initial_state(&kin(x(0.0).0 as f32));
-        let (mut num, mut den) = (0.0, 0.0);
-        for (k, r) in reference.iter().enumerate() {
-            let y = f64::from(m.step(&mut s, &kin(x(k as f64 / fs).0 as f32)));
-            num += (y - r) * (y - r);
-            den += r * r;
-        }
-        (num / den).sqrt()
-    }
-
-    fn sine(f: f64, c: f64, amp: f64) -> impl Fn(f64) -> (f64, f64) {
-        let w = 2.0 * std::f64::consts::PI * f;
-        move |t| (c + amp * (w * t).sin(), amp * w * (w * t).cos())
-    }
-
-    /// One step per sample against a fine f64 RK4 of eq. 28 for every integrator branch
-    /// (n = 1, 2, general; c₂ of both signs; both asymmetry functions), at slow rates
-    /// where ψ matters and at 9 Hz.
-    #[test]
-    fn one_step_per_sample_matches_fine_reference() {
-        let mut sets: Vec<[f32; 12]> = vec![A17, A18];
-        // n = 1 and n = 2, c₂ < 0 (β > γ) and c₂ > 0, δ large enough to matter.
-        sets.push([0.3, 1.0, 1.2, 1.0, 3.0, 1.0, 1.0, 0.1, 0.05, 0.0, 0.0, 1.0]);
-        sets.push([0.3, 1.0, 1.2, 1.0, 1.0, 3.0, 1.0, -0.2, 0.05, 0.0, 0.0, 1.0]);
-        sets.push([0.3, 1.0, 0.8, 1.0, 4.0, -1.0, 2.0, 0.0, 0.2, 4.0, 0.4, 2.0]);
-        sets.push([0.3, 1.0, 0.8, 1.0, 1.0, 4.0, 2.0, 0.0, -0.1, 4.0, 0.4, 2.0]);
-        sets.push([0.3, 1.0, 0.8, 2.0, 3.0, 1.0, 3.7, 0.0, 0.2, 3.0, 0.6, 2.0]);
-        sets.push([0.3, 1.0, 0.8, -2.0, 3.0, 1.0, 1.3, 0.0, 0.2, 0.0, 0.6, 1.0]);
-        for pr in &sets {
-            for (f, fs) in [(0.05, 100.0), (1.0, 500.0), (9.0, 500.0)] {
-                let samples = (2.0 * fs / f) as usize;
-                let e = r_rmse(pr, &sine(f, 0.5, 0.5), fs, samples);
-                eprintln!("ABW {pr:?} {f} Hz at {fs} Hz: R-RMSE {e:.2e}");
-                assert!(e < 3e-3, "{pr:?} at {f} Hz / {fs} Hz: R-RMSE {e}");
-            }
-        }
-    }
-
-    #[test]
-    fn state_stays_bounded() {
-        for pr in [A17, A18] {
-            let m = BoucWenAsym::from_params(&pr, 1e-3).unwrap();
-            let lim = m.z_limit();
-            assert!(lim >= m.z_bar());
-            let mut s = m.initial_state(&kin(0.0));
-            for x in [0.0, 1e30, -1e30, 3e38, -3e38, 0.5, 0.5, 0.5, 1e-30, 0.0, 7.0] {
-                for _ in 0..3 {
-                    let y = m.step(&mut s, &kin(x));
-                    assert!(s.z.abs() <= lim && s.z.is_finite(), "x={x}: z {}", s.z);
-                    assert!(y.is_finite() || x.abs() > 1e37);
-                }
-            }
-            // Eq. 31 at standstill drifts (ψ ≠ 0 with sgn(0) = 0) until the limit holds it.
-            let mut s = m.initial_state(&kin(0.9));
-            for _ in 0..200_000 {
-                m.step(&mut s, &kin(0.9));
-            }
-            assert!(s.z.abs() <= lim);
-        }
-    }
-
-    /// z on the rising and falling branch of the steady loop of eq. 28 for a triangular
-    /// input 0 → 1 → 0 at `rate`, by f64 RK4 (independent of the model's integrator).
-    fn rk4_loop(pr: &[f32; 12], rate: f64) -> (Vec<f64>, Vec<f64>) {
-        let p: Vec<f64> = pr.iter().map(|v| f64::from(*v)).collect();
-        let (d, a, beta, gamma, n, delta) = (p[2], p[3], p[4], p[5], p[6], p[8]);
-        assert_eq!(pr[11], 1.0);
-        let rhs = |z: f64, x: f64, xd: f64| {
-            let psi = delta * x * xd.signum();
-            (a * xd - beta * xd.abs() * z.abs().powf(n - 1.0) * z - gamma * xd * z.abs().powf(n) + psi) / d
-        };
-        let m = LOOP_POINTS;
-        let sub = 100;
-        let dx = 1.0 / m as f64;
-        let h = dx / rate / sub as f64;
-        let mut z = p[7];
-        let sweep = |z: &mut f64, up: bool, rec: &mut Vec<f64>| {
-            rec.push(*z);
-            for i in 0..m {
-                let xd = if up { rate } else { -rate };
-                let x0 = if up { i as f64 * dx } else { 1.0 - i as f64 * dx };
-                for j in 0..sub {
-                    let x = x0 + xd * h * j as f64;
-                    let k1 = rhs(*z, x, xd);
-                    let k2 = rhs(*z + 0.5 * h * k1, x + 0.5 * h * xd, xd);
-                    let k3 = rhs(*z + 0.5 * h * k2, x + 0.5 * h * xd, xd);
-                    let k4 = rhs(*z + h * k3, x + h * xd, xd);
-                    *z += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-                }
-                rec.push(*z);
-            }
-        };
-        let mut scratch = Vec::new();
-        for _ in 0..8 {
-            sweep(&mut z, true, &mut scratch);
-            sweep(&mut z, false, &mut scratch);
-        }
-        let (mut up, mut down) = (Vec::new(), Vec::new());
-        sweep(&mut z, true, &mut up);
-        sweep(&mut z, false, &mut down);
-        down.reverse();
-        (up, down)
-    }
-
-    /// The crossing detector fires for an eq. 30 set whose loop crosses (confirmed by an
-    /// independent f64 integration of eq. 28) and not for benign sets.
-    #[test]
-    fn crossing_detector() {
-        // Eq. 30 with δ·A < 0: at rate 0.025 the asymmetry term reverses the loop in the
-        // upper part of the range only (seed 004 Fig. 18a's artefact).
-        let crossing = [0.3, 1.0, 1.0, 1.0, 2.0, 1.0, 1.0, 0.0, -0.05, 0.0, 0.0, 1.0];
-        let m = BoucWenAsym::from_params(&crossing, 1e-3).unwrap();
-        assert!(m.crossing_risk(0.0, 1.0, 0.025));
-        let (up, down) = rk4_loop(&crossing, 0.025);
-        let diff: Vec<f64> = up.iter().zip(&down).map(|(u, d)| d - u).collect();
-        let (lo, hi) = diff.iter().fold((0.0f64, 0.0f64), |(l, h), v| (l.min(*v), h.max(*v)));
-        assert!(lo < -0.01 && hi > 0.01, "reference loop does not cross: {lo} {hi}");
-        // The model's loop is the reference's.
-        let b = m.steady_loop(0.0, 1.0, 0.025).unwrap();
-        for (i, (u, d)) in up.iter().zip(&down).enumerate() {
-            assert!((f64::from(b.up[i]) - u).abs() < 2e-3 && (f64::from(b.down[i]) - d).abs() < 2e-3, "i={i}");
-        }
-        // Rate dependence: the same set is benign when driven fast.
-        assert!(!m.crossing_risk(0.0, 1.0, 1.0));
-        // Without asymmetry a classical loop never crosses.
-        let mut classical = crossing;
-        classical[8] = 0.0;
-        let c = BoucWenAsym::from_params(&classical, 1e-3).unwrap();
-        for rate in [1.0, 0.1, 0.025, 0.01] {
-            assert!(!c.crossing_risk(0.0, 1.0, rate));
-        }
-        // Seed 004's ABW₁ and ABW₂ fits (signs as printed) at the paper's rate.
-        for pr in [A17, A18] {
-            assert!(!BoucWenAsym::from_params(&pr, 1e-3).unwrap().crossing_risk(0.0, 1.0, 0.1));
-        }
-        assert!(!m.crossing_risk(1.0, 0.0, 0.025));
-        assert!(!m.crossing_risk(0.0, 1.0, 0.0));
-    }
-
-    #[test]
-    fn rejects_bad_params() {
-        let m = BoucWenAsym::from_params(&A17, 1e-3).unwrap();
-        let mut out = [0.0; 12];
-        assert_eq!(m.write_params(&mut out), 12);
-        assert_eq!(out, A17);
-        for (i, v) in [
-            (0, 1.5),
-            (1, 0.0),
-            (2, 0.0),
-            (3, 0.0),
-            (4, -1.0),
-            (5, -17.0),
-            (6, 0.5),
-            (7, 1.0),
-            (9, -1.0),
-            (11, 3.0),
-            (11, 1.5),
-            (8, f32::NAN),
-        ] {
-            let mut bad = A17;
-            bad[i] = v;
-            assert!(BoucWenAsym::from_params(&bad, 1e-3).is_err(), "index {i} = {v}");
-        }
-        assert!(BoucWenAsym::from_params(&A17[..11], 1e-3).is_err());
-        assert!(BoucWenAsym::from_params(&A17, 0.0).is_err());
-    }
-}
+mod tests;

@@ -23,7 +23,7 @@
 //!
 //! # Short steps (the firmware's hot path)
 //! At 20 kHz a step moves B by a small fraction of the relaxation length 1/α. When
-//! `α·|ΔB| + k_t·|B̈| ≤ 1/16` (see [`FAST_Y`], [`TURN_EPS`]) the step uses the same update
+//! `α·|ΔB| + k_t·|B̈| ≤ 1/16` (see `FAST_Y` here and `TURN_EPS` in `kernels::turning`) the step uses the same update
 //! with `1 − e^{−y}` written as `y·φ(y)`, `φ(y) = 1 − y/2 + y²/6 − y³/24` (error ≤ y⁴/120 <
 //! 1.3e-7 relative), and without the reversal split, whose effect there is below
 //! `TURN_EPS·|z|`. No libm call, no division: about 40 instructions on the Cortex-M4F
@@ -32,24 +32,24 @@
 use crate::error::{check, count, finite, time_step};
 use crate::math::{abs, clamp, expm1};
 use crate::model::write_flat;
-use crate::models::bouc_wen::turning_point;
+use crate::models::kernels::turning::{turning_point, TURN_EPS};
 use crate::{Finite, Kin, Model, ParamError};
 
 /// Coefficients of eq. 7–8.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LuGre {
     /// α > 0, per unit B.
-    pub alpha: f32,
+    alpha: f32,
     /// β, N·m (scale of the hysteretic torque, β/α per unit z).
-    pub beta: f32,
+    beta: f32,
     /// ε, N·m·s (damping of ż).
-    pub epsilon: f32,
+    epsilon: f32,
     /// Viscous coefficient c, N·m·s per unit B.
-    pub c: f32,
+    c: f32,
     /// Stiffness k, N·m per unit B.
-    pub k: f32,
+    k: f32,
     /// Residual torque T₀, N·m.
-    pub t0: f32,
+    t0: f32,
     dt: f32,
     beta_a: f32,
     eps_a: f32,
@@ -59,11 +59,47 @@ pub struct LuGre {
     turn_k: f32,
 }
 
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl LuGre {
+    /// α > 0, per unit B.
+    #[inline]
+    pub fn alpha(&self) -> f32 {
+        self.alpha
+    }
+
+    /// β, N·m (scale of the hysteretic torque, β/α per unit z).
+    #[inline]
+    pub fn beta(&self) -> f32 {
+        self.beta
+    }
+
+    /// ε, N·m·s (damping of ż).
+    #[inline]
+    pub fn epsilon(&self) -> f32 {
+        self.epsilon
+    }
+
+    /// Viscous coefficient c, N·m·s per unit B.
+    #[inline]
+    pub fn c(&self) -> f32 {
+        self.c
+    }
+
+    /// Stiffness k, N·m per unit B.
+    #[inline]
+    pub fn k(&self) -> f32 {
+        self.k
+    }
+
+    /// Residual torque T₀, N·m.
+    #[inline]
+    pub fn t0(&self) -> f32 {
+        self.t0
+    }
+}
+
 /// Largest `α·|ΔB|` (plus the reversal term) handled by the short-step series.
 pub(crate) const FAST_Y: f32 = 1.0 / 16.0;
-/// Largest `α·|B̈|·dt²` (the z change a reversal inside the step could make) for which the
-/// short-step path ignores the reversal.
-pub(crate) const TURN_EPS: f32 = 2.0e-3;
 
 /// `(1 − e^{−y})/y` for `|y| ≤ FAST_Y`: Taylor to y³ (error ≤ y⁴/120).
 #[inline(always)]
@@ -87,6 +123,29 @@ impl Finite for State {
 pub type Registered = LuGre;
 
 impl LuGre {
+    /// Validate eq. 7–8's coefficients: `0 < α ≤ 1e6`, the others finite, `β/α` and `ε/α`
+    /// finite.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::lugre::{LuGre, SEED000_AVERAGE};
+    /// use model_core::rate::RateParams;
+    /// use model_core::{Estimator, Model, Sample};
+    ///
+    /// let dt = 1e-4;
+    /// let [alpha, beta, epsilon, c, k, t0] = SEED000_AVERAGE;
+    /// let model = LuGre::new(alpha, beta, epsilon, c, k, t0, dt)?;
+    /// assert_eq!(model.dt(), dt);
+    /// let est = Estimator::new(model, RateParams::filtered(dt, 200.0)?)?;
+    /// let mut state = est.state();
+    /// for i in 0..200 {
+    ///     let b = 1.5 + 1.5 * (core::f32::consts::TAU * 5.0 * i as f32 * dt).sin();
+    ///     let out = est.step(&mut state, Sample::new(b));
+    ///     assert!(out.flags.ok() && out.y.is_finite());
+    /// }
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(alpha: f32, beta: f32, epsilon: f32, c: f32, k: f32, t0: f32, dt: f32) -> Result<Self, ParamError> {
         let alpha = check("alpha", alpha, f32::MIN_POSITIVE, 1.0e6)?;
         let beta = finite("beta", beta)?;
@@ -127,6 +186,20 @@ impl LuGre {
         clamp(z1, -1.0, 1.0)
     }
 }
+
+/// Seed 000 (Yang & Kermani 2023) Table 4, the five per-frequency fits and their average
+/// (clutch input B, T in N·m), in [`Model::from_params`] order `alpha, beta, epsilon, c, k, t0`.
+pub const SEED000_TABLE4: [(&str, [f32; 6]); 6] = [
+    ("1 Hz", [5.315, 6.251, 0.042, -0.443, 4.441, 5.508]),
+    ("3 Hz", [3.590, 6.456, 0.017, -0.144, 4.947, 5.326]),
+    ("5 Hz", [5.695, 5.831, 0.000, -0.105, 3.469, 5.146]),
+    ("7 Hz", [3.062, 5.783, -0.030, -0.026, 4.859, 5.036]),
+    ("9 Hz", [3.899, 4.534, -0.014, -0.038, 3.769, 5.110]),
+    ("average", SEED000_AVERAGE),
+];
+
+/// The average row of [`SEED000_TABLE4`].
+pub const SEED000_AVERAGE: [f32; 6] = [4.312, 5.771, 0.003, -0.151, 4.297, 5.225];
 
 impl Model for LuGre {
     type State = State;
@@ -198,120 +271,4 @@ impl LuGre {
 }
 
 #[cfg(test)]
-mod tests {
-    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
-    use super::*;
-    use std::vec::Vec;
-
-    /// Seed 000 Table 4 average.
-    fn avg(dt: f32) -> LuGre {
-        LuGre::new(4.312, 5.771, 0.003, -0.151, 4.297, 5.225, dt).unwrap()
-    }
-
-    #[test]
-    fn equation_values_hand_computed() {
-        let m = LuGre::new(2.0, 3.0, 0.5, 0.1, 4.0, 1.0, 1e-3).unwrap();
-        // Small step up from z = 0.25: dz = α(1 − z)·ΔB = 2·0.75·1e-3.
-        let mut s = State { z: 0.25, x_prev: 1.0 };
-        let y = m.step(&mut s, &Kin::new(1.001, 2.0, 0.0, 0.0));
-        let z = 0.25 + 2.0 * 0.75 * 1.0e-3;
-        assert!((s.z - z).abs() < 2e-6, "{}", s.z);
-        let zdot = 2.0 * (2.0 - 2.0 * z);
-        let want = 3.0 / 2.0 * z + 0.1 * 2.0 + 4.0 * 1.001 + 0.5 / 2.0 * zdot + 1.0;
-        assert!((y - want).abs() < 1e-4, "{y} vs {want}");
-        // Exact over a long leg: z = s + (z0 − s)e^{−αL}.
-        let mut s = State { z: 0.25, x_prev: 1.0 };
-        m.step(&mut s, &Kin::new(0.3, -1.0, 0.0, 0.0));
-        let want = -1.0 + (0.25f64 + 1.0) * (-2.0f64 * 0.7).exp();
-        assert!((f64::from(s.z) - want).abs() < 1e-6);
-    }
-
-    fn rk4_vs_model(m: &LuGre, f: f64, dt: f64, periods: f64) -> f64 {
-        let w = 2.0 * core::f64::consts::PI * f;
-        let x = |t: f64| (1.5 + 1.5 * (w * t).sin(), 1.5 * w * (w * t).cos(), -1.5 * w * w * (w * t).sin());
-        let a = f64::from(m.alpha);
-        let zd = |z: f64, xd: f64| a * xd - a * xd.abs() * z;
-        let steps = (periods / f / dt).round() as usize;
-        let sub = 400;
-        let h = dt / sub as f64;
-        let (mut z, mut num, mut den) = (0.0f64, 0.0, 0.0);
-        let first = x(0.0);
-        let mut s = m.initial_state(&Kin::new(first.0 as f32, 0.0, 0.0, 0.0));
-        for i in 0..steps {
-            for j in 0..sub {
-                let t = i as f64 * dt + j as f64 * h;
-                let k1 = zd(z, x(t).1);
-                let k2 = zd(z + 0.5 * h * k1, x(t + 0.5 * h).1);
-                let k3 = zd(z + 0.5 * h * k2, x(t + 0.5 * h).1);
-                let k4 = zd(z + h * k3, x(t + h).1);
-                z += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-            }
-            let (xx, xd, xdd) = x((i + 1) as f64 * dt);
-            let y = m.step(&mut s, &Kin::new(xx as f32, xd as f32, xdd as f32, 0.0));
-            let yref = f64::from(m.beta) / a * z
-                + f64::from(m.c) * xd
-                + f64::from(m.k) * xx
-                + f64::from(m.epsilon) / a * zd(z, xd)
-                + f64::from(m.t0);
-            num += (yref - f64::from(y)).powi(2);
-            den += yref * yref;
-        }
-        (num / den).sqrt()
-    }
-
-    #[test]
-    fn exact_update_matches_rk4() {
-        for dt in [1.0 / 500.0, 1.0 / 3000.0] {
-            for f in [1.0, 5.0, 9.0] {
-                let e = rk4_vs_model(&avg(dt as f32), f, dt, 3.0);
-                assert!(e < 5e-5, "f={f} dt={dt}: {e}");
-                // A stiffer α (ten times Table 4) is still exact at one step per sample.
-                let stiff = LuGre::new(43.0, 5.771, 0.3, -0.151, 4.297, 5.225, dt as f32).unwrap();
-                let e = rk4_vs_model(&stiff, f, dt, 3.0);
-                assert!(e < 5e-5, "stiff f={f} dt={dt}: {e}");
-            }
-        }
-    }
-
-    #[test]
-    fn z_bounded_and_saturates() {
-        let m = avg(1e-3);
-        let mut s = State::default();
-        for i in 0..5000 {
-            m.step(&mut s, &Kin::new(i as f32 * 0.01, 10.0, 0.0, 0.0));
-            assert!(s.z.abs() <= 1.0);
-        }
-        assert!((s.z - 1.0).abs() < 1e-6);
-        // z follows sgn(Ḃ): the (B, z) loop is clockwise (∮ z dB > 0, dissipative), so its
-        // shoelace sum is negative.
-        let n = 600;
-        let mut s = State::default();
-        let mut pts = Vec::new();
-        for i in 0..(3 * n) {
-            let b = (2.0 * core::f32::consts::PI * i as f32 / n as f32).sin();
-            m.step(&mut s, &Kin::new(b, 0.0, 0.0, 0.0));
-            if i >= 2 * n {
-                pts.push((f64::from(b), f64::from(s.z)));
-            }
-        }
-        let mut area = 0.0;
-        for i in 0..n {
-            let (p, q) = (pts[i], pts[(i + 1) % n]);
-            area += p.0 * q.1 - q.0 * p.1;
-        }
-        assert!(area < -0.2, "{area}");
-    }
-
-    #[test]
-    fn rejects_invalid() {
-        assert!(LuGre::new(0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1e-3).is_err());
-        assert!(LuGre::new(-1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1e-3).is_err());
-        assert!(LuGre::new(1e-30, 1e10, 0.0, 0.0, 0.0, 0.0, 1e-3).is_err());
-        assert!(LuGre::new(1.0, f32::INFINITY, 0.0, 0.0, 0.0, 0.0, 1e-3).is_err());
-        assert!(LuGre::from_params(&[1.0; 5], 1e-3).is_err());
-        let p = [4.312, 5.771, 0.003, -0.151, 4.297, 5.225];
-        let mut out = [0.0; 6];
-        assert_eq!(LuGre::from_params(&p, 1e-3).unwrap().write_params(&mut out), 6);
-        assert_eq!(out, p);
-    }
-}
+mod tests;

@@ -20,7 +20,8 @@
 use crate::error::{check, count, finite, time_step};
 use crate::math::clamp;
 use crate::model::write_flat;
-use crate::models::prandtl_ishlinskii::{block_names, operator_count, pick, to_array, MAX_OPERATORS};
+use crate::models::kernels::names::{block_names, pick};
+use crate::models::kernels::operators::{operator_count, to_array, MAX_OPERATORS};
 use crate::{Finite, Kin, Model, ParamError};
 
 const K_BLOCKS: [&str; MAX_OPERATORS + 1] = block_names!("k");
@@ -30,16 +31,43 @@ const F_BLOCKS: [&str; MAX_OPERATORS + 1] = block_names!("f");
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MaxwellSlip<const N: usize> {
     /// Output offset w₀ (output units).
-    pub w0: f32,
+    w0: f32,
     /// Spring stiffnesses kᵢ > 0 (output units per unit x).
-    pub k: [f32; N],
+    k: [f32; N],
     /// Breakaway forces fᵢ ≥ 0 (output units).
-    pub f: [f32; N],
+    f: [f32; N],
     /// Linear term k₀ (output units per unit x); 0 in seed 004.
-    pub k0: f32,
+    k0: f32,
     /// Deflection limits fᵢ/kᵢ (unit of x).
     lim: [f32; N],
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl<const N: usize> MaxwellSlip<N> {
+    /// Output offset w₀ (output units).
+    #[inline]
+    pub fn w0(&self) -> f32 {
+        self.w0
+    }
+
+    /// Spring stiffnesses kᵢ > 0 (output units per unit x).
+    #[inline]
+    pub fn k(&self) -> &[f32; N] {
+        &self.k
+    }
+
+    /// Breakaway forces fᵢ ≥ 0 (output units).
+    #[inline]
+    pub fn f(&self) -> &[f32; N] {
+        &self.f
+    }
+
+    /// Linear term k₀ (output units per unit x); 0 in seed 004.
+    #[inline]
+    pub fn k0(&self) -> f32 {
+        self.k0
+    }
 }
 
 /// Previous input and the spring deflections `dᵢ = x − x_bᵢ` (unit of x).
@@ -67,6 +95,20 @@ pub type Registered = MaxwellSlip<10>;
 impl<const N: usize> MaxwellSlip<N> {
     /// `kᵢ > 0`, `fᵢ ≥ 0` (seed 004 Table A15 bounds 0.01…10 and 0…10), `w₀`, `k₀` finite,
     /// `1 ≤ N ≤ 64`.
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::maxwell_slip::MaxwellSlip;
+    /// use model_core::{Kin, Model};
+    ///
+    /// // Two elasto-slide elements (stiffness k, slip force f), offset w₀, linear spring k₀.
+    /// let model = MaxwellSlip::new(0.1, [1.0, 10.0], [0.5, 0.2], 0.3, 1e-3)?;
+    /// let mut state = model.initial_state(&Kin::new(0.0, 0.0, 0.0, 0.0));
+    /// let y = model.step(&mut state, &Kin::new(0.04, 0.0, 0.0, 0.0));
+    /// assert!(y.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     pub fn new(w0: f32, k: [f32; N], f: [f32; N], k0: f32, dt: f32) -> Result<Self, ParamError> {
         operator_count(N)?;
         let mut lim = [0.0; N];
@@ -137,102 +179,4 @@ impl<const N: usize> Model for MaxwellSlip<N> {
 }
 
 #[cfg(test)]
-mod tests {
-    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
-    use super::*;
-
-    fn kin(x: f32) -> Kin {
-        Kin::new(x, 0.0, 0.0, 0.0)
-    }
-
-    /// One elasto-slide element against eq. 23–24 written out with block positions.
-    #[test]
-    fn element_matches_eq23_24() {
-        let (k, f) = (2.0f32, 1.0f32);
-        let m = MaxwellSlip::new(0.0, [k], [f], 0.0, 1e-3).unwrap();
-        let xs = [0.0f32, 0.25, 0.5, 1.0, 0.8, 0.5, 0.0, -0.5, -0.25, 0.3];
-        let mut s = m.initial_state(&kin(xs[0]));
-        // Textbook reference with the block position x_b.
-        let mut xb = xs[0];
-        let mut xprev = xs[0];
-        for &x in &xs {
-            let y = m.step(&mut s, &kin(x));
-            let trial = k * (x - xb);
-            let want = if trial.abs() < f {
-                trial
-            } else {
-                let sg = (x - xprev).signum();
-                xb = x - f / k * sg;
-                f * sg
-            };
-            xprev = x;
-            assert!((y - want).abs() < 1e-6, "x={x}: {y} vs {want}");
-        }
-        // Hand values: rising to 1.0 saturates at f; back at 0.5 the spring is relaxed.
-        let mut s = m.initial_state(&kin(0.0));
-        for (x, w) in [(0.25, 0.5), (1.0, 1.0), (0.5, 0.0), (0.0, -1.0)] {
-            let y = m.step(&mut s, &kin(x));
-            assert!((y - w).abs() < 1e-6, "x={x}: {y} vs {w}");
-        }
-    }
-
-    #[test]
-    fn sum_offset_linear_term_and_bounds() {
-        let m = MaxwellSlip::new(0.1, [1.0, 10.0], [0.5, 0.2], 0.3, 1e-3).unwrap();
-        let mut s = m.initial_state(&kin(0.0));
-        // x = 0.04: element 1 elastic (0.04 < 0.5/1), element 2 slips at f = 0.2
-        // (its deflection limit is 0.2/10 = 0.02): 0.1 + 0.3·0.04 + 0.04 + 0.2
-        let y = m.step(&mut s, &kin(0.04));
-        assert!((y - (0.1 + 0.012 + 0.04 + 0.2)).abs() < 1e-6, "{y}");
-        // x = 0.03: element 2 unloads elastically from +0.02 to +0.01.
-        let y = m.step(&mut s, &kin(0.03));
-        assert!((y - (0.1 + 0.009 + 0.03 + 0.1)).abs() < 1e-6, "{y}");
-        // x = 1e30 then back: deflections never exceed f/k.
-        m.step(&mut s, &kin(1e30));
-        assert_eq!(s.d, [0.5, 0.02]);
-        m.step(&mut s, &kin(-1e30));
-        assert_eq!(s.d, [-0.5, -0.02]);
-    }
-
-    /// The loop of an elasto-slide element is clockwise (seed 004 §5): the rising branch
-    /// (F = +f once sliding) lies above the falling branch (F = −f).
-    #[test]
-    fn loop_is_clockwise() {
-        let m = MaxwellSlip::new(0.0, [1.0], [0.2], 0.0, 1e-3).unwrap();
-        let mut s = m.initial_state(&kin(-1.0));
-        let n = 200;
-        let mut up = 0.0;
-        let mut down = 0.0;
-        for cycle in 0..2 {
-            for i in 0..=2 * n {
-                let x = if i <= n { -1.0 + 2.0 * i as f32 / n as f32 } else { 3.0 - 2.0 * i as f32 / n as f32 };
-                let y = m.step(&mut s, &kin(x));
-                if cycle == 1 && i == n / 2 {
-                    up = y;
-                }
-                if cycle == 1 && i == 3 * n / 2 {
-                    down = y;
-                }
-            }
-        }
-        // Both samples at x = 0.
-        assert!(up > down, "up {up} down {down}");
-        assert!((up - 0.2).abs() < 1e-6 && (down + 0.2).abs() < 1e-6);
-    }
-
-    #[test]
-    fn rejects_bad_params() {
-        assert!(MaxwellSlip::new(0.0, [0.0], [1.0], 0.0, 1e-3).is_err());
-        assert!(MaxwellSlip::new(0.0, [1.0], [-1.0], 0.0, 1e-3).is_err());
-        assert!(MaxwellSlip::new(f32::INFINITY, [1.0], [1.0], 0.0, 1e-3).is_err());
-        type M = MaxwellSlip<2>;
-        assert_eq!(M::PARAM_NAMES, &["w0", "k[2]", "f[2]", "k0"]);
-        let v = [0.1, 1.0, 2.0, 0.5, 0.6, 0.3];
-        let m = M::from_params(&v, 1e-3).unwrap();
-        assert_eq!((m.k, m.f, m.k0), ([1.0, 2.0], [0.5, 0.6], 0.3));
-        let mut out = [0.0; 6];
-        assert_eq!(m.write_params(&mut out), 6);
-        assert_eq!(out, v);
-        assert!(M::from_params(&v[..5], 1e-3).is_err());
-    }
-}
+mod tests;

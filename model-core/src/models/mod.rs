@@ -3,6 +3,12 @@
 //! Every module exports its coefficient type (implementing [`Model`](crate::Model)),
 //! its `State`, and `pub type Registered = …;` — the concrete type (for const-generic
 //! models, the default size) listed by [`registry`](crate::registry).
+//!
+//! Pieces several models share (the command filter, reversal detection, name tables, …)
+//! live in `kernels` (crate-private); a model module uses kernels, never another model.
+
+// Shared pieces (no model module uses another).
+pub(crate) mod kernels;
 
 // Seed 000 (Yang & Kermani 2023), input B.
 pub mod algebraic;

@@ -37,7 +37,9 @@
 use crate::error::{check, count, time_step};
 use crate::math::clamp;
 use crate::model::write_flat;
-use crate::models::hammerstein_wiener::{sigmoid, take, BlockName, W_MAX};
+use crate::models::kernels::flat::take;
+use crate::models::kernels::names::BlockName;
+use crate::models::kernels::sigmoid::{sigmoid, W_MAX};
 use crate::{Finite, Kin, Model, ParamError};
 
 /// Clamp of the normalised inputs.
@@ -46,20 +48,89 @@ const U_LIM: f32 = 1.0e6;
 /// Coefficients of the NARX model with `H` hidden sigmoid units.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Narx<const H: usize> {
-    pub u_mean: f32,
-    pub u_scale: f32,
-    pub y_mean: f32,
-    pub y_scale: f32,
+    u_mean: f32,
+    u_scale: f32,
+    y_mean: f32,
+    y_scale: f32,
     /// W₁…W₇ of eq. 19 (on ŷ(t−1), û(t), …, û(t−5)).
-    pub lin: [f32; 7],
+    lin: [f32; 7],
     /// Hidden-layer weights, one row of 7 per unit.
-    pub hid_w: [[f32; 7]; H],
-    pub hid_b: [f32; H],
-    pub out_a: [f32; H],
-    pub offset: f32,
-    pub y_min: f32,
-    pub y_max: f32,
+    hid_w: [[f32; 7]; H],
+    hid_b: [f32; H],
+    out_a: [f32; H],
+    offset: f32,
+    y_min: f32,
+    y_max: f32,
     dt: f32,
+}
+
+/// Read access to the validated parameters (set only by `new`/`from_params`).
+impl<const H: usize> Narx<H> {
+    /// Mean of the input subtracted before scaling.
+    #[inline]
+    pub fn u_mean(&self) -> f32 {
+        self.u_mean
+    }
+
+    /// Scale of the input: `û = (u − u_mean)/u_scale`.
+    #[inline]
+    pub fn u_scale(&self) -> f32 {
+        self.u_scale
+    }
+
+    /// Mean of the output: `ŷ = (y − y_mean)/y_scale`.
+    #[inline]
+    pub fn y_mean(&self) -> f32 {
+        self.y_mean
+    }
+
+    /// Scale of the normalised output.
+    #[inline]
+    pub fn y_scale(&self) -> f32 {
+        self.y_scale
+    }
+
+    /// W₁…W₇ of eq. 19 (on ŷ(t−1), û(t), …, û(t−5)).
+    #[inline]
+    pub fn lin(&self) -> &[f32; 7] {
+        &self.lin
+    }
+
+    /// Hidden-layer weights, one row of 7 per unit.
+    #[inline]
+    pub fn hid_w(&self) -> &[[f32; 7]; H] {
+        &self.hid_w
+    }
+
+    /// Hidden-layer biases, one per unit.
+    #[inline]
+    pub fn hid_b(&self) -> &[f32; H] {
+        &self.hid_b
+    }
+
+    /// Output weights, one per hidden unit.
+    #[inline]
+    pub fn out_a(&self) -> &[f32; H] {
+        &self.out_a
+    }
+
+    /// Output offset of the network (normalised units).
+    #[inline]
+    pub fn offset(&self) -> f32 {
+        self.offset
+    }
+
+    /// Lower clamp of the output y.
+    #[inline]
+    pub fn y_min(&self) -> f32 {
+        self.y_min
+    }
+
+    /// Upper clamp of the output y.
+    #[inline]
+    pub fn y_max(&self) -> f32 {
+        self.y_max
+    }
 }
 
 /// Past inputs `u(t−1) … u(t−5)` (raw units) and the last output `y(t−1)`.
@@ -89,6 +160,28 @@ impl<const H: usize> Narx<H> {
     const N_OUT_A: BlockName = BlockName::new("out_a", H);
 
     /// Validate and build (bounds in the module doc).
+    ///
+    /// # Examples
+    ///
+    /// ```
+    /// use model_core::models::narx::Narx;
+    /// use model_core::{Kin, Model};
+    ///
+    /// let model = Narx::<2>::new(
+    ///     (1.0, 2.0, 0.5, 4.0), // u_mean, u_scale, y_mean, y_scale
+    ///     [0.6, 0.3, -0.2, 0.1, 0.05, -0.05, 0.02], // linear part
+    ///     [[0.1, 0.2, 0.3, -0.1, 0.0, 0.5, -0.4], [-0.3, 0.1, 0.0, 0.2, 0.2, -0.1, 0.3]], // hidden weights
+    ///     [0.1, -0.2], // hidden biases
+    ///     [1.5, -0.7], // output weights
+    ///     0.05,        // offset
+    ///     (-100.0, 100.0), // output clamp
+    ///     1e-3,
+    /// )?;
+    /// let mut state = model.initial_state(&Kin::new(1.0, 0.0, 0.0, 0.0));
+    /// let y = model.step(&mut state, &Kin::new(1.2, 0.0, 0.0, 0.0));
+    /// assert!(y.is_finite());
+    /// # Ok::<(), model_core::ParamError>(())
+    /// ```
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         (u_mean, u_scale, y_mean, y_scale): (f32, f32, f32, f32),
@@ -247,157 +340,4 @@ impl<const H: usize> Model for Narx<H> {
 }
 
 #[cfg(test)]
-mod tests {
-    #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
-    use super::*;
-    use std::vec::Vec;
-
-    fn sg(s: f64) -> f64 {
-        1.0 / (1.0 + (-s).exp())
-    }
-
-    fn small() -> Narx<2> {
-        Narx::<2>::new(
-            (1.0, 2.0, 0.5, 4.0),
-            [0.6, 0.3, -0.2, 0.1, 0.05, -0.05, 0.02],
-            [[0.1, 0.2, 0.3, -0.1, 0.0, 0.5, -0.4], [-0.3, 0.1, 0.0, 0.2, 0.2, -0.1, 0.3]],
-            [0.1, -0.2],
-            [1.5, -0.7],
-            0.05,
-            (-100.0, 100.0),
-            1e-3,
-        )
-        .unwrap()
-    }
-
-    /// f64 re-implementation of eq. 18–19 with the same normalisation.
-    fn reference(m: &Narx<2>, u: &[f64], y0: f64, u0: f64) -> Vec<f64> {
-        let f = |v: f32| f64::from(v);
-        let mut hist = std::vec![u0; 5];
-        let mut y = y0;
-        let mut out = Vec::new();
-        for &ut in u {
-            let mut r = std::vec![(y - f(m.y_mean)) / f(m.y_scale), (ut - f(m.u_mean)) / f(m.u_scale)];
-            for h in &hist {
-                r.push((h - f(m.u_mean)) / f(m.u_scale));
-            }
-            let mut yn: f64 = m.lin.iter().zip(&r).map(|(a, b)| f(*a) * b).sum::<f64>() + f(m.offset);
-            for j in 0..2 {
-                let s: f64 = m.hid_w[j].iter().zip(&r).map(|(a, b)| f(*a) * b).sum::<f64>() + f(m.hid_b[j]);
-                yn += f(m.out_a[j]) * sg(s);
-            }
-            y = (f(m.y_mean) + f(m.y_scale) * yn).clamp(f(m.y_min), f(m.y_max));
-            hist.insert(0, ut);
-            hist.pop();
-            out.push(y);
-        }
-        out
-    }
-
-    #[test]
-    fn matches_eq18_19() {
-        let m = small();
-        let mut s = State { u: [0.0; 5], y: 0.0 };
-        let u: Vec<f64> = (0..50).map(|i| (i as f64 * 0.3).sin() * 2.0 + 1.0).collect();
-        let want = reference(&m, &u, 0.0, 0.0);
-        for (ut, w) in u.iter().zip(&want) {
-            let y = m.step(&mut s, &Kin::new(*ut as f32, 0.0, 0.0, 0.0));
-            assert!((f64::from(y) - w).abs() < 1e-4 * (1.0 + w.abs()), "{y} vs {w}");
-        }
-    }
-
-    #[test]
-    fn feedback_clamped() {
-        // W₁ = 3 makes the open recursion explode; the clamp keeps it in range.
-        let mut m = small();
-        m.lin[0] = 3.0;
-        let m = Narx::<2>::new(
-            (m.u_mean, m.u_scale, m.y_mean, m.y_scale),
-            m.lin,
-            m.hid_w,
-            m.hid_b,
-            m.out_a,
-            m.offset,
-            (-20.0, 30.0),
-            1e-3,
-        )
-        .unwrap();
-        let mut s = m.initial_state(&Kin::new(1.0, 0.0, 0.0, 0.0));
-        let mut hit = false;
-        for i in 0..500 {
-            let y = m.step(&mut s, &Kin::new((i as f32 * 0.1).sin(), 0.0, 0.0, 0.0));
-            assert!((-20.0..=30.0).contains(&y));
-            hit |= y == 30.0 || y == -20.0;
-        }
-        assert!(hit, "the recursion should have reached the clamp");
-        for u in [1e30f32, -1e30, 3e38] {
-            let y = m.step(&mut s, &Kin::new(u, 0.0, 0.0, 0.0));
-            assert!(y.is_finite() && s.is_finite());
-        }
-    }
-
-    #[test]
-    fn steady_start() {
-        let m = small();
-        let mut s = m.initial_state(&Kin::new(0.7, 0.0, 0.0, 0.0));
-        let y0 = s.y;
-        for _ in 0..5 {
-            let y = m.step(&mut s, &Kin::new(0.7, 0.0, 0.0, 0.0));
-            assert!((y - y0).abs() < 1e-4 * (1.0 + y0.abs()), "{y} vs {y0}");
-        }
-    }
-
-    #[test]
-    fn steady_start_with_a_slow_feedback() {
-        // W₁ = 0.9995: iterating the map 32 times would leave the start far from steady.
-        let m = small();
-        let m = Narx::<2>::new(
-            (m.u_mean, m.u_scale, m.y_mean, m.y_scale),
-            [0.9995, 0.3, -0.2, 0.1, 0.05, -0.05, 0.02],
-            m.hid_w,
-            m.hid_b,
-            m.out_a,
-            0.01,
-            (-1.0e5, 1.0e5),
-            1e-3,
-        )
-        .unwrap();
-        let k = Kin::new(0.7, 0.0, 0.0, 0.0);
-        let mut s = m.initial_state(&k);
-        let y0 = s.y;
-        // An interior fixed point, far from y_mean.
-        assert!(y0.abs() > 100.0 && y0.abs() < 0.5e5, "{y0}");
-        for _ in 0..200 {
-            let y = m.step(&mut s, &k);
-            assert!((y - y0).abs() < 1e-3 * (1.0 + y0.abs()), "{y} vs {y0}");
-        }
-    }
-
-    #[test]
-    fn names_and_round_trip() {
-        assert_eq!(Registered::N_PARAMS, 86);
-        assert_eq!(Seed000::N_PARAMS, 653);
-        let total = |names: &[&str]| -> usize {
-            names
-                .iter()
-                .map(|n| n.split_once('[').map_or(1, |(_, r)| r.trim_end_matches(']').parse::<usize>().unwrap()))
-                .sum()
-        };
-        assert_eq!(total(Registered::PARAM_NAMES), Registered::N_PARAMS);
-        assert_eq!(total(Seed000::PARAM_NAMES), Seed000::N_PARAMS);
-        assert!(Seed000::PARAM_NAMES.contains(&"hid_w[497]"));
-        assert!(Registered::PARAM_NAMES.contains(&"hid_w[56]"));
-        let m = small();
-        let mut out = [0.0f32; 32];
-        assert_eq!(m.write_params(&mut out), 32);
-        let back = Narx::<2>::from_params(&out, 1e-3).unwrap();
-        assert_eq!(back, m);
-        let mut bad = out;
-        bad[1] = 0.0; // u_scale
-        assert!(Narx::<2>::from_params(&bad, 1e-3).is_err());
-        let mut bad = out;
-        bad[31] = -200.0; // y_max < y_min
-        assert!(Narx::<2>::from_params(&bad, 1e-3).is_err());
-        assert!(Narx::<2>::from_params(&out[..31], 1e-3).is_err());
-    }
-}
+mod tests;

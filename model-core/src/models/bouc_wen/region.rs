@@ -1,0 +1,82 @@
+//! Exact integration of one sign region of `w = sgn(ẋ)·z` along the stroke for `n = 1`
+//! (exponential) and `n = 2` (Riccati: `tanh`/`tan` forms), stopping where `w` reaches 0
+//! (module docs of [`bouc_wen`](super)).
+
+use crate::math::{atan, expm1, sqrt, tanh};
+
+/// Result of integrating one sign region.
+pub(super) enum Leg {
+    /// Stayed in the region; the final |w|.
+    Done(f32),
+    /// Reached w = 0 with this much of the leg left.
+    Crossed(f32),
+}
+
+/// `dv/dξ = p − q·v` from `v0 ≥ 0` over `l`, stopping at `v = 0` (exact).
+pub(super) fn region_n1(v0: f32, l: f32, p: f32, q: f32) -> Leg {
+    // v(ξ) = v0 + (p − q v0)·φ(ξ), φ(ξ) = (1 − e^{−qξ})/q.
+    let phi = |x: f32| if q == 0.0 { x } else { -expm1(-q * x) / q };
+    let f0 = p - q * v0;
+    if p < 0.0 && f0 < 0.0 {
+        let phi_star = v0 / -f0;
+        let phi_l = phi(l);
+        if phi_l >= phi_star {
+            let xi = if q == 0.0 { phi_star } else { -libm::log1pf(-q * phi_star) / q };
+            let rem = l - xi;
+            return Leg::Crossed(if rem > 0.0 { rem } else { 0.0 });
+        }
+        let v = v0 + f0 * phi_l;
+        return Leg::Done(if v > 0.0 { v } else { 0.0 });
+    }
+    Leg::Done(v0 + f0 * phi(l))
+}
+
+/// `dv/dξ = p − q·v²` from `v0 ≥ 0` over `l`, stopping at `v = 0` (exact Riccati).
+pub(super) fn region_n2(v0: f32, l: f32, p: f32, q: f32) -> Leg {
+    if q == 0.0 {
+        let v = v0 + p * l;
+        if p < 0.0 && v <= 0.0 {
+            let rem = l - v0 / -p;
+            return Leg::Crossed(if rem > 0.0 { rem } else { 0.0 });
+        }
+        return Leg::Done(v);
+    }
+    if p > 0.0 {
+        if q > 0.0 {
+            // v = s·tanh(rξ + atanh(v0/s)) in Möbius form (valid for v0 > s too).
+            let s = sqrt(p / q);
+            let t = tanh(sqrt(p * q) * l);
+            return Leg::Done(s * (v0 + s * t) / (s + v0 * t));
+        }
+        // p > 0 > q: finite-distance blow-up; outside the validated class.
+        return Leg::Done(f32::INFINITY);
+    }
+    if q > 0.0 {
+        // dv/dξ = −(|p| + q v²): v = s·tan(atan(v0/s) − rξ).
+        let s = sqrt(-p / q);
+        let r = sqrt(-p * q);
+        let th = atan(v0 / s);
+        let rl = r * l;
+        if rl >= th {
+            let rem = l - th / r;
+            return Leg::Crossed(if rem > 0.0 { rem } else { 0.0 });
+        }
+        let t = libm::tanf(rl);
+        let v = s * (v0 - s * t) / (s + v0 * t);
+        return Leg::Done(if v > 0.0 { v } else { 0.0 });
+    }
+    // p < 0, q < 0: dv/dξ = −|q|(s² − v²), v = s·tanh(atanh(v0/s) − rξ) while v0 < s.
+    let s = sqrt(p / q);
+    if v0 >= s {
+        return Leg::Done(v0);
+    }
+    let r = sqrt(p * q);
+    let u = v0 / s;
+    let t = tanh(r * l);
+    if t >= u {
+        let rem = l - libm::atanhf(u) / r;
+        return Leg::Crossed(if rem > 0.0 { rem } else { 0.0 });
+    }
+    let v = s * (v0 - s * t) / (s - v0 * t);
+    Leg::Done(if v > 0.0 { v } else { 0.0 })
+}

@@ -1,0 +1,73 @@
+#![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::panic)]
+use super::*;
+use crate::control::page::RateSpec;
+use crate::control::ControlConfig;
+
+#[test]
+fn commands_round_trip() {
+    let all = [
+        Command::SetTorque(6.25),
+        Command::Enable(true),
+        Command::Enable(false),
+        Command::Reset,
+        Command::GetStatus,
+        Command::ConfigBegin { len: 2048 },
+        Command::ConfigData { offset: 2040, len: 3, data: [1, 2, 3, 0, 0] },
+        Command::ConfigCommit { crc: 0xDEAD_BEEF },
+    ];
+    for c in all {
+        let mut f = [0u8; FRAME];
+        let n = c.encode(&mut f);
+        assert_eq!(Command::decode(&f[..n]), Ok(c), "{c:?}");
+    }
+    assert_eq!(Command::decode(&[0x55]), Err(Nack::Unknown));
+    assert_eq!(Command::decode(&[]), Err(Nack::Malformed));
+    assert_eq!(Command::decode(&[0x01, 0, 0]), Err(Nack::Malformed));
+    assert_eq!(Command::decode(&[0x01, 0, 0, 0xC0, 0x7F]), Err(Nack::Malformed), "NaN reference");
+    assert_eq!(Command::decode(&[0x02, 7]), Err(Nack::Malformed));
+    assert_eq!(Command::decode(&[0x11, 0, 0]), Err(Nack::Malformed), "empty chunk");
+}
+
+#[test]
+fn responses_round_trip() {
+    for r in [Response::Ack(0x02), Response::Nack(0x12, Nack::InvalidPage)] {
+        let mut f = [0u8; FRAME];
+        let n = r.encode(&mut f);
+        assert_eq!(Response::decode(&f[..n]), Some(r));
+    }
+    let mut f = [0u8; FRAME];
+    let n = Response::Status { mode: 2, fault: 0, overruns: 3, torque_est: 7.5 }.encode(&mut f);
+    assert_eq!(n, 8);
+    let Some(Response::Status { mode, overruns, torque_est, .. }) = Response::decode(&f) else { panic!() };
+    assert_eq!((mode, overruns), (2, 3));
+    assert_eq!(torque_est, 7.5);
+}
+
+#[test]
+fn a_page_over_the_wire() {
+    let c = ControlConfig::defaults(5e-5).validate().unwrap();
+    let img = ConfigImage::new("algebraic", &crate::models::algebraic::SEED000_AVERAGE, RateSpec::Backward, c).unwrap();
+    let page = img.encode();
+    let len = usize::from(u16::from_le_bytes([page[6], page[7]])) + 4;
+    let mut a = PageAssembler::default();
+    assert_eq!(a.data(0, &[1]), Err(Nack::Sequence));
+    a.begin(len as u16).unwrap();
+    for (k, chunk) in page[..len].chunks(CHUNK).enumerate() {
+        let mut f = [0u8; FRAME];
+        let mut d = [0u8; CHUNK];
+        d[..chunk.len()].copy_from_slice(chunk);
+        let n = Command::ConfigData { offset: (k * CHUNK) as u16, len: chunk.len() as u8, data: d }.encode(&mut f);
+        match Command::decode(&f[..n]).unwrap() {
+            Command::ConfigData { offset, len, data } => a.data(offset, &data[..usize::from(len)]).unwrap(),
+            other => panic!("{other:?}"),
+        }
+    }
+    assert_eq!(a.data(len as u16, &[0]), Err(Nack::Sequence), "beyond the announced length");
+    let crc = !crate::control::config::crc32_update(!0, &page[..len]);
+    let mut bad = a.clone();
+    assert_eq!(bad.commit(crc ^ 1).unwrap_err(), Nack::TransferCrc);
+    let (bytes, back) = a.commit(crc).unwrap();
+    assert_eq!(back, img);
+    assert_eq!(bytes[..], page[..]);
+    assert_eq!(a.commit(crc).unwrap_err(), Nack::Sequence, "one commit per transfer");
+}
