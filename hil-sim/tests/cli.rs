@@ -11,7 +11,6 @@ fn hil_sim(args: &[&str]) -> (i32, String, String) {
     )
 }
 
-
 #[test]
 fn models_json_lists_all_17_with_contract_fields() {
     let (code, out, _) = hil_sim(&["models", "--json"]);

@@ -245,3 +245,9 @@ pub fn network_layout(names: &[&'static str], n_params: usize) -> Vec<ParamSpec>
     }
     ps
 }
+
+/// A published value that model-core stores as f32, as the paper prints it: the shortest
+/// decimal that reads back to the same f32 (46.9, not 46.900001525878906).
+pub fn published(v: f32) -> f64 {
+    v.to_string().parse().unwrap_or(f64::from(v))
+}

@@ -3,15 +3,17 @@
 
 pub(crate) mod reference;
 
-use model_core::models::spencer::Registered;
+use model_core::models::spencer::{Registered, DYKE_1997_FLAT};
 
 use super::reference::Case;
-use super::search::{ParamSpec, Scales, Spreads, Strategy};
+use super::search::{published, ParamSpec, Scales, Spreads, Strategy};
 use super::HostModel;
 
-/// Spencer et al. (1997) for the Dyke damper (x in cm, F in N, v in V), in flat order.
-pub(crate) const DYKE_1997: [f64; 14] =
-    [21.0, 3.5, 46.9, 283.0, 2.95, 5.0, 14.3, 140.0, 695.0, 363.0, 363.0, 301.0, 2.0, 190.0];
+/// Spencer et al. (1997) for the Dyke damper (x in cm, F in N, v in V), in flat order:
+/// model-core's [`DYKE_1997_FLAT`] as published.
+pub(crate) fn dyke_1997() -> [f64; 14] {
+    DYKE_1997_FLAT.map(published)
+}
 /// The spreads of `ranran_50.csv` (D, V, F) the published set is rescaled from.
 pub(crate) const DYKE_SCALES: (f64, f64, f64) = (0.35, 16.0, 430.0);
 
@@ -39,7 +41,7 @@ impl HostModel for Registered {
             (0.0, 0.0, 0.0, 0.0),   // eta
         ];
         let uu = if no_u { 1.0 } else { u / 2.25 };
-        let scaled: Vec<f64> = DYKE_1997
+        let scaled: Vec<f64> = dyke_1997()
             .iter()
             .zip(dims)
             .map(|(p0, (ex, ev, ey, eu))| p0 * fx.powf(ex) * fv.powf(ev) * fy.powf(ey) * uu.powf(eu))

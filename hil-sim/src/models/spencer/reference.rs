@@ -37,23 +37,12 @@ pub struct Spencer {
 }
 
 /// Spencer et al. (1997) for the prototype damper of `shared/data/dyke` (x in cm, F in N,
-/// v in V), as listed in `shared/data/dyke/README.md`.
-pub const DYKE_1997: Spencer = Spencer {
-    c0a: 21.0,
-    c0b: 3.50,
-    k0: 46.9,
-    c1a: 283.0,
-    c1b: 2.95,
-    k1: 5.00,
-    x0: 14.3,
-    alpha_a: 140.0,
-    alpha_b: 695.0,
-    gamma: 363.0,
-    beta: 363.0,
-    a: 301.0,
-    n: 2.0,
-    eta: 190.0,
-};
+/// v in V): model-core's [`model_core::models::spencer::DYKE_1997_FLAT`] as published.
+pub fn dyke_1997() -> Spencer {
+    let [c0a, c0b, k0, c1a, c1b, k1, x0, alpha_a, alpha_b, gamma, beta, a, n, eta] =
+        model_core::models::spencer::DYKE_1997_FLAT.map(crate::models::search::published);
+    Spencer { c0a, c0b, k0, c1a, c1b, k1, x0, alpha_a, alpha_b, gamma, beta, a, n, eta }
+}
 
 impl Spencer {
     /// Flat vector in model-core's parameter order.
@@ -131,8 +120,8 @@ pub fn cases() -> Vec<Case> {
         .map(|(i, &volt)| Case {
             model: "spencer",
             label: format!("Spencer et al. 1997, Dyke damper (shared/data/dyke/README.md), x in cm, F in N, {volt} V"),
-            params: DYKE_1997.flat(),
-            reference: Box::new(DYKE_1997),
+            params: dyke_1997().flat(),
+            reference: Box::new(dyke_1997()),
             scale: InputScale { amplitude: 1.0, offset: 0.0 },
             command: Command::Constant(volt),
             // The recording carries its own command; checking it once is enough.
@@ -264,7 +253,7 @@ pub(crate) mod tests {
     /// The f32 core (one step per sample) against this reference (RK4, 200 sub-steps).
     #[test]
     fn core_matches_reference() {
-        let r = DYKE_1997;
+        let r = dyke_1997();
         // (a) 9 Hz, 1 cm sine at 500 Hz and 3 kHz; the core gets exact x, ẋ per sample
         // (the harness's synthetic protocol) and, separately, a piecewise-linear input with
         // backward-difference rates.
