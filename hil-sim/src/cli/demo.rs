@@ -5,13 +5,13 @@ use clap::Args;
 use hil_sim::closed_loop::{compare as loop_compare, identify, multisine_reference, Run, T_START};
 use hil_sim::dispatch::RateChoice;
 use hil_sim::fit::{Dataset, FitOptions, FitResult};
-use hil_sim::fit_report::{error_bars, fit_plots, results_table, Labels};
 use hil_sim::params_file::ParamsFile;
 use hil_sim::plant::ClutchParams;
-use hil_sim::plot::{self, Series, Style};
 use hil_sim::quality;
 use hil_sim::recording::Recording;
 use hil_sim::replay::{replay_recording, Channels};
+use hil_sim::report::fit::{error_bars, fit_plots, results_table, Labels};
+use hil_sim::report::plot::{self, Series, Style};
 use hil_sim::report::Report;
 use serde_json::json;
 

@@ -220,7 +220,7 @@ pub fn write_report(
     input: &str,
     output: &str,
 ) -> anyhow::Result<PathBuf> {
-    use hil_sim::fit_report::{error_bars, fit_plots, loop_plots, results_table, Labels};
+    use hil_sim::report::fit::{error_bars, fit_plots, loop_plots, results_table, Labels};
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut rep = hil_sim::report::Report::new(title);
     rep.paragraph(&format!(

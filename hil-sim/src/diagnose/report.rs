@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use super::{locate, Diagnosis};
-use crate::plot::{self, PlotError};
+use crate::report::plot::{self, PlotError};
 use crate::report::Report;
 
 /// Add the diagnosis to `rep`, its plots written to `dir` as `<stem>_*.svg`.

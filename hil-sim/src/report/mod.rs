@@ -12,6 +12,9 @@
 //! r.write("target/report").unwrap();
 //! ```
 
+pub mod fit;
+pub mod plot;
+
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
