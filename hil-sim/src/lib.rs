@@ -14,6 +14,7 @@ pub mod excitation;
 pub mod export;
 pub mod fit;
 pub mod metrics;
+pub mod numerics;
 pub mod params_file;
 pub mod plant;
 pub mod quality;
