@@ -10,8 +10,8 @@
 //! envelope: peaks and the drawn line survive exactly); x–y plots drop consecutive points
 //! that fall on the same pixel and, past [`MAX_XY_POINTS`], keep an even stride.
 //!
-//! One file per plot kind: [`time_series`] (lines over time), [`residual`] (a residual
-//! over time with shaded windows), [`hysteresis_loop`] (output against input) and [`bars`]
+//! One file per plot kind: [`time_series()`] (lines over time), [`residual()`] (a residual
+//! over time with shaded windows), [`hysteresis_loop()`] (output against input) and [`bars()`]
 //! (grouped bars); `canvas` holds the shared picture, axes, legend and tick labels,
 //! `range` the axis ranges, `decimate` the reduction of long series, `style` the colours.
 
