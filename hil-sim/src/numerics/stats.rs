@@ -1,5 +1,5 @@
 //! Descriptive statistics of sample slices: mean, population standard deviation (1/n),
-//! RMS, median, rank quantiles and extremes.
+//! mean square and RMS, median, rank quantiles and extremes.
 //!
 //! Sums run over the slice in order, so a caller that replaces its own copy of one of
 //! these gets the same bits. An empty slice gives 0 (its length counts as 1), except where
@@ -22,9 +22,14 @@ pub fn std(v: &[f64]) -> f64 {
     mean_std(v).1
 }
 
+/// Mean square Σv² / n (e.g. a mean squared error of residuals); 0 for an empty slice.
+pub fn mean_square(v: &[f64]) -> f64 {
+    v.iter().map(|a| a * a).sum::<f64>() / v.len().max(1) as f64
+}
+
 /// Root mean square √(Σv² / n); 0 for an empty slice.
 pub fn rms(v: &[f64]) -> f64 {
-    (v.iter().map(|a| a * a).sum::<f64>() / v.len().max(1) as f64).sqrt()
+    mean_square(v).sqrt()
 }
 
 /// Median as the element of rank ⌊n/2⌋ in [`f64::total_cmp`] order (the upper of the two
@@ -63,6 +68,7 @@ mod tests {
         let (m, s) = mean_std(&[2.0, 4.0, 4.0, 4.0, 5.0, 5.0, 7.0, 9.0]);
         assert_eq!((m, s), (5.0, 2.0));
         assert_eq!(std(&[2.0, 4.0, 4.0, 4.0, 5.0, 5.0, 7.0, 9.0]), 2.0);
+        assert_eq!(mean_square(&[3.0, 4.0, 0.0, 0.0]), 6.25);
         assert_eq!(rms(&[3.0, 4.0, 0.0, 0.0]), 2.5);
         assert_eq!(median(&v), 3.0);
         assert_eq!(median(&[1.0, 2.0]), 2.0);
