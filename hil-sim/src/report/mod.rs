@@ -1,6 +1,7 @@
 //! A small Markdown report: headings, paragraphs, tables and figures, written as
 //! `report.md` and as `index.html` (the same Markdown rendered by pulldown-cmark, with SVG
-//! figures found beside the report inlined so the page stands alone).
+//! figures found beside the report inlined so the page stands alone). The SVG figures
+//! come from [`plot`]; [`fit`] adds the plots and table of fit results.
 //!
 //! ```no_run
 //! # use hil_sim::report::Report;
