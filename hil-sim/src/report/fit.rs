@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
+use super::plot::{self, PlotError, Series, Style};
+use super::Report;
 use crate::ident::fit::{Dataset, FitResult};
-use crate::report::plot::{self, PlotError, Series, Style};
-use crate::report::Report;
 
 /// Axis labels with units, e.g. `("D (cm)", "F (N)")`.
 #[derive(Clone, Debug)]

@@ -1,6 +1,7 @@
 //! A small Markdown report: headings, paragraphs, tables and figures, written as
 //! `report.md` and as `index.html` (the same Markdown rendered by pulldown-cmark, with SVG
-//! figures found beside the report inlined so the page stands alone).
+//! figures found beside the report inlined so the page stands alone). The SVG figures
+//! come from [`plot`]; [`fit`] adds the plots and table of fit results.
 //!
 //! ```no_run
 //! # use hil_sim::report::Report;
@@ -11,6 +12,10 @@
 //!     .image("loop.svg", "Force against displacement");
 //! r.write("target/report").unwrap();
 //! ```
+
+pub mod fit;
+pub mod fit_page;
+pub mod plot;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -247,7 +252,3 @@ mod tests {
         assert_eq!(r.title(), "t");
     }
 }
-
-pub mod fit;
-pub mod fit_page;
-pub mod plot;

@@ -1,0 +1,51 @@
+//! How series are drawn: colour (the Okabe–Ito palette by default), stroke width in
+//! pixels, opacity; and the fonts of captions, axis labels and ticks.
+
+use plotters::prelude::*;
+
+pub(super) const FONT: &str = "sans-serif";
+// plotters' SVG backend writes font-size = size / 1.24: these give about 20, 15 and 13 px.
+pub(super) const CAPTION_PX: u32 = 25;
+pub(super) const LABEL_PX: u32 = 19;
+pub(super) const TICK_PX: u32 = 16;
+
+/// Colour-blind safe palette (Okabe–Ito), used in order for series without a colour.
+pub const PALETTE: [(u8, u8, u8); 7] =
+    [(0, 114, 178), (213, 94, 0), (0, 158, 115), (204, 121, 167), (230, 159, 0), (86, 180, 233), (90, 90, 90)];
+
+/// How one series is drawn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Style {
+    /// RGB colour; `None` takes the next [`PALETTE`] colour.
+    pub color: Option<(u8, u8, u8)>,
+    /// Stroke width in pixels.
+    pub width: u32,
+    /// 0 (invisible) ..= 1 (opaque).
+    pub opacity: f64,
+}
+
+impl Default for Style {
+    fn default() -> Self {
+        Self { color: None, width: 2, opacity: 0.85 }
+    }
+}
+
+impl Style {
+    /// A solid line of the given colour, 2 px.
+    pub const fn rgb(r: u8, g: u8, b: u8) -> Self {
+        Self { color: Some((r, g, b)), width: 2, opacity: 1.0 }
+    }
+    pub const fn width(mut self, width: u32) -> Self {
+        self.width = width;
+        self
+    }
+    pub const fn opacity(mut self, opacity: f64) -> Self {
+        self.opacity = opacity;
+        self
+    }
+    pub(super) fn shape(&self, index: usize) -> ShapeStyle {
+        let (r, g, b) = self.color.unwrap_or(PALETTE[index % PALETTE.len()]);
+        let a = if self.opacity.is_finite() { self.opacity.clamp(0.0, 1.0) } else { 1.0 };
+        RGBColor(r, g, b).mix(a).stroke_width(self.width.max(1))
+    }
+}
