@@ -11,6 +11,7 @@ use crate::io::recording::Channels;
 use crate::io::recording::{Recording, RecordingError};
 use crate::models::search::Scales;
 use crate::numerics::derivative::gradient;
+use crate::numerics::stats::mean_std;
 use crate::quality::{self, Quality};
 
 /// Why a dataset could not be built.
@@ -100,11 +101,6 @@ impl Dataset {
     pub fn scales(&self) -> Scales {
         let rows = self.train_rows();
         let pick = |v: &[f64]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
-        let mean_std = |v: &[f64]| {
-            let n = v.len().max(1) as f64;
-            let m = v.iter().sum::<f64>() / n;
-            (m, (v.iter().map(|a| (a - m) * (a - m)).sum::<f64>() / n).sqrt())
-        };
         let x = pick(&self.input);
         let dx = gradient(&self.input, self.dt);
         let ddx = gradient(&dx, self.dt);

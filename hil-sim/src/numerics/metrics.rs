@@ -40,7 +40,7 @@ pub fn metrics(measured: &[f64], model: &[f64], rates: Option<(&[f64], &[f64])>)
         return Metrics::default();
     }
     let (y, m) = (&measured[..n], &model[..n]);
-    let mean = y.iter().sum::<f64>() / n as f64;
+    let mean = super::stats::mean(y);
     let sse: f64 = y.iter().zip(m).map(|(a, b)| sq(a - b)).sum();
     let sst: f64 = y.iter().map(|a| sq(a - mean)).sum();
     let ssy: f64 = y.iter().map(|a| sq(*a)).sum();

@@ -50,10 +50,10 @@ fn fixed(name: &'static str, v: f64) -> ParamSpec {
     ParamSpec { name, lo: v, hi: v, start: v, spacing: Spacing::Linear, fixed: true }
 }
 
+/// Mean and standard deviation (floored at 1e-12: a scale to divide by).
 fn mean_std(v: &[f64]) -> (f64, f64) {
-    let n = v.len().max(1) as f64;
-    let m = v.iter().sum::<f64>() / n;
-    (m, (v.iter().map(|a| (a - m) * (a - m)).sum::<f64>() / n).sqrt().max(1e-12))
+    let (m, s) = crate::numerics::stats::mean_std(v);
+    (m, s.max(1e-12))
 }
 
 fn subsample(rows: &[usize]) -> Vec<usize> {

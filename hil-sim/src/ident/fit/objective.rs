@@ -125,7 +125,7 @@ impl<'a> Objective<'a> {
     /// Mean squared scaled residual (∞ when invalid).
     pub fn cost(&self, p: &[f64]) -> f64 {
         match self.residuals(p) {
-            Some(r) if !r.is_empty() => r.iter().map(|v| v * v).sum::<f64>() / r.len() as f64,
+            Some(r) if !r.is_empty() => crate::numerics::stats::mean_square(&r),
             _ => f64::INFINITY,
         }
     }
