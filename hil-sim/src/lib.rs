@@ -18,6 +18,7 @@ pub mod metrics;
 pub mod params_file;
 pub mod plant;
 pub mod plot;
+pub mod progress;
 pub mod quality;
 pub mod rate_offline;
 pub mod recording;
