@@ -7,7 +7,7 @@
 //! PWM edge ([`crate::plant`]). The true torque is the plant's.
 //! The slow supervisor pass (`ControlStep::slow`) runs every millisecond, as in the firmware.
 //!
-//! [`identify`] plays the lab: on the simulated clutch, with the same step in current
+//! [`identify`](fn@identify) plays the lab: on the simulated clutch, with the same step in current
 //! mode as the current driver, it records sines and a slow triangle, fits seed 000's
 //! algebraic model (eq. 14, linear least squares on Hall B, its rate from the
 //! controller's own rate estimator, and the load-cell torque) for the closed loop, and the
