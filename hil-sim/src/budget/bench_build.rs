@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
-use super::BudgetError;
+use super::error::BudgetError;
 
 /// Build the bench with the shipping flags; returns the ELF.
 pub fn build_bench(workspace: &Path) -> Result<PathBuf, BudgetError> {

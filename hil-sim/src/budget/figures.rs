@@ -24,7 +24,7 @@ pub struct StepFigures {
     pub calls: u64,
     /// Measured beyond the operating envelope (no budget applies).
     pub outside: bool,
-    /// The target, if [`BUDGETS`](super::BUDGETS) has one.
+    /// The target, if [`BUDGETS`](super::table::BUDGETS) has one.
     pub budget: Option<Budget>,
 }
 

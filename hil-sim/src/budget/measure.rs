@@ -7,10 +7,10 @@ use std::path::Path;
 use std::process::Stdio;
 
 use super::bench_build::{build_bench, workspace_root};
+use super::error::BudgetError;
 use super::figures::Report;
 use super::tools::{disassemble, Tools};
 use super::trace::{parse_markers, Tracer};
-use super::BudgetError;
 use crate::progress::Progress;
 
 /// Run the bench ELF on QEMU (untraced for the markers, then traced) and measure.

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use super::cycles::{parse_disassembly, Cycles};
-use super::BudgetError;
+use super::error::BudgetError;
 
 /// Address → cycle bounds of every instruction in the ELF (`llvm-objdump -d`).
 pub fn disassemble(objdump: &Path, elf: &Path) -> Result<HashMap<u32, Cycles>, BudgetError> {

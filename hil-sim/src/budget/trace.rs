@@ -6,9 +6,9 @@
 use std::collections::HashMap;
 
 use super::cycles::{c, Cycles};
+use super::error::BudgetError;
 use super::figures::StepFigures;
 use super::table::BUDGETS;
-use super::BudgetError;
 
 /// One `step|outside <name> <address> <calls>` line of the bench.
 #[derive(Clone, Debug, PartialEq, Eq)]

@@ -5,11 +5,11 @@
 use model_core::control::{FaultCode, Mode};
 use serde::Serialize;
 
-use super::harness::{run, Run};
+use super::error::LoopError;
+use super::harness::{run, Run, T_START};
 use super::identify::Identified;
 use super::injection::{Injection, Schedule};
 use super::references::multisine_reference;
-use super::{LoopError, T_START};
 use crate::plant::ClutchParams;
 
 /// Result of one injected fault.

@@ -5,8 +5,7 @@ use model_core::control::{ControlStep, ValidatedConfig};
 use model_core::Model;
 use serde::Serialize;
 
-use super::harness::{run, Run};
-use super::T_START;
+use super::harness::{run, Run, T_START};
 use crate::plant::ClutchParams;
 
 /// Gain |T/r| of the true torque at frequency `f` over samples `[k0, k1)`.

@@ -7,9 +7,11 @@ use model_core::Model;
 use serde::Serialize;
 
 use super::injection::{Injection, Schedule};
-use super::T_START;
 use crate::metrics::{metrics, Metrics};
 use crate::plant::{ClutchParams, Plant};
+
+/// Time the loop gets before the reference starts (calibration 0.1 s + margin), s.
+pub const T_START: f64 = 0.15;
 
 /// One run, sample by sample (plain vectors for CSV and plots).
 #[derive(Clone, Debug, Default, Serialize)]

@@ -10,11 +10,11 @@ use model_core::models::algebraic::Algebraic;
 use model_core::rate::{RateParams, RateState};
 use serde::Serialize;
 
-use super::harness::run;
+use super::error::LoopError;
+use super::harness::{run, T_START};
 use super::injection::NanAfter;
 use super::least_squares::least_squares;
-use super::tuning::{current_driver, torque_config};
-use super::{LoopError, RATE_FC_HZ, T_START};
+use super::tuning::{current_driver, torque_config, RATE_FC_HZ};
 use crate::excitation::Excitation;
 use crate::metrics::metrics;
 use crate::plant::ClutchParams;

@@ -19,8 +19,10 @@
 //! [`identify`](mod@identify) (the lab's fits), [`least_squares`](mod@least_squares),
 //! [`faults`] (one injected fault, judged), [`frequency_response`](mod@frequency_response)
 //! (stepped sines, −3 dB bandwidth), [`step_response`] (10–90 % rise times), [`heating`]
-//! (error drift as the fluid heats), [`scenarios`] (the `loop` scenarios as one call).
+//! (error drift as the fluid heats), [`references`] (the scenarios' torque references),
+//! [`scenarios`] (the `loop` scenarios as one call), [`error`] (why a run could not be set up).
 
+pub mod error;
 pub mod faults;
 pub mod frequency_response;
 pub mod harness;
@@ -33,12 +35,10 @@ pub mod scenarios;
 pub mod step_response;
 pub mod tuning;
 
-use model_core::ParamError;
-use thiserror::Error;
-
+pub use error::LoopError;
 pub use faults::{fault_run, is_fault, FaultResult};
 pub use frequency_response::{bandwidth, frequency_response, GainPoint, SWEEP_HZ};
-pub use harness::{run, Run};
+pub use harness::{run, Run, T_START};
 pub use heating::{heating_windows, HeatingWindow, WindowError};
 pub use identify::{identify, Identified};
 pub use injection::{Injection, NanAfter, NanState, Schedule};
@@ -46,21 +46,4 @@ pub use least_squares::least_squares;
 pub use references::multisine_reference;
 pub use scenarios::{compare, evaluate, LoopReport, LoopScenario, LoopSpec, ScenarioFigures};
 pub use step_response::{rise_time, step_rises, StepRise};
-pub use tuning::{base_config, current_driver};
-
-/// Why a loop run could not be set up.
-#[derive(Debug, Error)]
-pub enum LoopError {
-    #[error("controller parameters: {0}")]
-    Params(#[from] ParamError),
-    #[error("identification failed: {0}")]
-    Identify(String),
-    /// [`evaluate`] could not identify the clutch.
-    #[error("identifying the simulated clutch")]
-    Identifying(#[source] Box<LoopError>),
-}
-
-/// Cut-off of the controller's rate estimator (filtered difference), Hz.
-pub const RATE_FC_HZ: f32 = 150.0;
-/// Time the loop gets before the reference starts (calibration 0.1 s + margin), s.
-pub const T_START: f64 = 0.15;
+pub use tuning::{base_config, current_driver, RATE_FC_HZ};

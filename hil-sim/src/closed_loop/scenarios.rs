@@ -4,15 +4,15 @@
 
 use serde::Serialize;
 
+use super::error::LoopError;
 use super::faults::{fault_run, FaultResult};
 use super::frequency_response::{bandwidth, frequency_response, GainPoint};
-use super::harness::{run, Run};
+use super::harness::{run, Run, T_START};
 use super::heating::{heating_windows, HeatingWindow};
 use super::identify::{identify, Identified};
 use super::injection::Injection;
 use super::references::{multisine_reference, sine_reference, steps_reference, STEP_S};
 use super::step_response::{step_rises, StepRise};
-use super::{LoopError, T_START};
 use crate::metrics::Metrics;
 use crate::plant::ClutchParams;
 use crate::progress::Progress;

@@ -7,8 +7,11 @@ use model_core::control::{ControlConfig, ControlStep, LoopMode, ValidatedConfig}
 use model_core::models::algebraic::Algebraic;
 use model_core::rate::RateParams;
 
-use super::{LoopError, RATE_FC_HZ};
+use super::error::LoopError;
 use crate::plant::ClutchParams;
+
+/// Cut-off of the controller's rate estimator (filtered difference), Hz.
+pub const RATE_FC_HZ: f32 = 150.0;
 
 /// A current-mode controller (the current driver) at `control_hz`.
 pub fn current_driver(
