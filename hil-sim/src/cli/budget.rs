@@ -5,7 +5,8 @@ use std::path::PathBuf;
 
 use anyhow::bail;
 use clap::Args;
-use hil_sim::budget::{self, Tools};
+use hil_sim::budget;
+use hil_sim::progress::Progress;
 use serde_json::json;
 
 #[derive(Args, Debug)]
@@ -22,19 +23,17 @@ pub struct BudgetArgs {
     pub json: bool,
 }
 
+/// The library's progress messages as log lines on stderr.
+struct Log;
+
+impl Progress for Log {
+    fn message(&self, msg: &str) {
+        eprintln!("{msg}");
+    }
+}
+
 pub fn run(a: BudgetArgs) -> anyhow::Result<()> {
-    let tools = Tools::find()?;
-    let elf = match a.elf {
-        Some(p) => p,
-        None => {
-            eprintln!(
-                "building the bench (cargo build --release -p firmware --target thumbv7em-none-eabihf --bin budget)"
-            );
-            budget::build_bench(&budget::workspace_root())?
-        }
-    };
-    eprintln!("tracing {} on QEMU mps2-an386 (a minute or two)", elf.display());
-    let report = budget::measure(&tools, &elf)?;
+    let report = budget::run(a.elf.as_deref(), &Log)?;
     if a.json {
         let fig = |s: &budget::StepFigures| {
             json!({

@@ -41,6 +41,21 @@ pub fn normal_equations(cols: &[Vec<f64>], y: &[f64], rows: &[usize]) -> (DMatri
     (gram, atb)
 }
 
+/// Fit `y ≈ X·θ` for rows of `N` columns (the lab's small fits): the normal equations
+/// solved by LU with partial pivoting; `None` when they are singular or the solution is
+/// not finite.
+pub fn fit_rows<const N: usize>(rows: &[[f64; N]], y: &[f64]) -> Option<[f64; N]> {
+    let mut gram = DMatrix::<f64>::zeros(N, N);
+    let mut atb = DVector::<f64>::zeros(N);
+    for (x, yv) in rows.iter().zip(y) {
+        accumulate(&mut gram, &mut atb, x, *yv);
+    }
+    symmetrize(&mut gram);
+    let th = gram.lu().solve(&atb)?;
+    let x: [f64; N] = std::array::from_fn(|i| th[i]);
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
 /// Solve `g·θ = b` by SVD, singular values below `rcond` × the largest cut off.
 pub fn solve_svd(g: DMatrix<f64>, b: &DVector<f64>, rcond: f64) -> Option<DVector<f64>> {
     let svd = g.svd(true, true);
@@ -73,6 +88,15 @@ pub fn solve_cholesky(g: DMatrix<f64>, b: &DVector<f64>, svd_eps: f64) -> Option
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fit_rows_recovers_a_line() {
+        let rows: Vec<[f64; 2]> = (0..10).map(|k| [1.0, k as f64]).collect();
+        let y: Vec<f64> = (0..10).map(|k| 2.0 + 0.5 * k as f64).collect();
+        let th = fit_rows(&rows, &y).unwrap();
+        assert!((th[0] - 2.0).abs() < 1e-9 && (th[1] - 0.5).abs() < 1e-9);
+        assert!(fit_rows(&[[0.0, 0.0]], &[1.0]).is_none());
+    }
 
     #[test]
     fn recovers_a_line_and_zeroes_an_unexcited_column() {
