@@ -16,7 +16,7 @@
 //!
 //! Modules: [`harness`] (one run, sample by sample), [`injection`] (faults and how they
 //! enter the plant), [`tuning`] (settings from the data sheet and the identified slope),
-//! [`identify`](mod@identify) (the lab's fits),
+//! [`identify`](mod@identify) (the lab's fits, by [`crate::numerics::lstsq::fit_rows`]),
 //! [`faults`] (one injected fault, judged), [`frequency_response`](mod@frequency_response)
 //! (stepped sines, −3 dB bandwidth), [`step_response`] (10–90 % rise times), [`heating`]
 //! (error drift as the fluid heats), [`references`] (the scenarios' torque references),
