@@ -23,7 +23,7 @@ fn dataset(name: &str, duration: Option<f64>, ch: &Channels, train: f64) -> Data
     if let Some(d) = duration {
         sc.duration_s = d;
     }
-    let rec = sc.record().expect("simulation");
+    let rec = hil_sim::closed_loop::record::record(&sc).expect("simulation");
     let recording = rec.recording;
     let q = quality::check(&recording, ch).expect("quality checks");
     Dataset::new(&recording, ch, train, Some(q.excluded())).expect("dataset")

@@ -106,7 +106,7 @@ pub fn run_cmd(a: SimulateArgs) -> anyhow::Result<()> {
         );
     }
     let pb = super::progress(1, &sc.name);
-    let rec = sc.record()?;
+    let rec = hil_sim::closed_loop::record::record(&sc)?;
     pb.finish_and_clear();
     let (rows, r, k0) = (rec.recording.len(), &rec.run, rec.first);
     if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -121,7 +121,7 @@ pub fn run_cmd(a: SimulateArgs) -> anyhow::Result<()> {
             "scenario": sc.name, "description": sc.description, "out": a.out, "rows": rows,
             "record_hz": sc.record_hz, "control_hz": sc.control_hz,
             "torque_range": [tmin, tmax], "temperature_end_c": theta_end,
-            "columns": hil_sim::sim::scenario::RECORD_COLUMNS,
+            "columns": hil_sim::closed_loop::record::RECORD_COLUMNS,
         }));
     }
     super::emit(&format!(

@@ -20,7 +20,7 @@
 //! [`faults`] (one injected fault, judged), [`frequency_response`](mod@frequency_response)
 //! (stepped sines, −3 dB bandwidth), [`step_response`] (10–90 % rise times), [`heating`]
 //! (error drift as the fluid heats), [`references`] (the scenarios' torque references),
-//! [`scenarios`] (the `loop` scenarios as one call), [`error`] (why a run could not be set up).
+//! [`record`] (a current-driven scenario recorded, `hil-sim simulate`), [`scenarios`] (the `loop` scenarios as one call), [`error`] (why a run could not be set up).
 
 pub mod error;
 pub mod faults;
@@ -29,6 +29,7 @@ pub mod harness;
 pub mod heating;
 pub mod identify;
 pub mod injection;
+pub mod record;
 pub mod references;
 pub mod scenarios;
 pub mod step_response;
