@@ -41,13 +41,19 @@ fn make<M: Model>(img: &ConfigImage) -> Result<(ControlStep<M>, ControlState<M::
 impl Loop {
     /// The controller a page describes, validated (model parameters by `from_params`).
     pub fn from_image(img: &ConfigImage) -> Result<Self, PageError> {
-        Ok(match img.model_id() {
-            "algebraic" => make(img).map(|(s, st)| Self::Algebraic(s, st))?,
-            "bouc_wen" => make(img).map(|(s, st)| Self::BoucWen(s, st))?,
-            "lugre" => make(img).map(|(s, st)| Self::LuGre(s, st))?,
-            "tanh" => make(img).map(|(s, st)| Self::Tanh(s, st))?,
-            _ => return Err(PageError::WrongModel),
-        })
+        // The ids are the models' own (`Model::ID`, registered in model-core's registry).
+        let id = img.model_id();
+        if id == algebraic::Algebraic::ID {
+            make(img).map(|(s, st)| Self::Algebraic(s, st))
+        } else if id == bouc_wen::BoucWen::ID {
+            make(img).map(|(s, st)| Self::BoucWen(s, st))
+        } else if id == lugre::LuGre::ID {
+            make(img).map(|(s, st)| Self::LuGre(s, st))
+        } else if id == tanh::Tanh::ID {
+            make(img).map(|(s, st)| Self::Tanh(s, st))
+        } else {
+            Err(PageError::WrongModel)
+        }
     }
 
     fn slow(&mut self, cfg: &ValidatedConfig, temperature: f32) {
@@ -79,7 +85,7 @@ pub fn default_image() -> Result<ConfigImage, PageError> {
     let control = ControlConfig { mode: LoopMode::Torque, ..ControlConfig::defaults(dt) }
         .validate()
         .map_err(PageError::Invalid)?;
-    ConfigImage::new("algebraic", &[20.0, -0.05, -10.0, 0.8], RateSpec::Filtered { fc: 150.0 }, control)
+    ConfigImage::new(algebraic::Algebraic::ID, &[20.0, -0.05, -10.0, 0.8], RateSpec::Filtered { fc: 150.0 }, control)
 }
 
 /// What the interrupt owns.
