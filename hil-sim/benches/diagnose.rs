@@ -6,8 +6,8 @@
 //! models fitted first), as the CLI runs it (both cores).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use hil_sim::concealed::{generate, ConcealedSpec};
-use hil_sim::diagnose::{diagnose, DiagnoseOptions};
+use hil_sim::sim::concealed::{generate, ConcealedSpec};
+use hil_sim::ident::diagnose::{diagnose, DiagnoseOptions};
 use hil_sim::fit::Dataset;
 use hil_sim::recording::Recording;
 use hil_sim::replay::Channels;

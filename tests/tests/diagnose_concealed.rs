@@ -20,8 +20,8 @@
 
 use std::path::Path;
 
-use hil_sim::concealed::{generate, ConcealedSpec};
-use hil_sim::diagnose::{diagnose, DiagnoseOptions};
+use hil_sim::sim::concealed::{generate, ConcealedSpec};
+use hil_sim::ident::diagnose::{diagnose, DiagnoseOptions};
 use hil_sim::fit::Dataset;
 use hil_sim::recording::Recording;
 use hil_sim::replay::Channels;

@@ -199,7 +199,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         "The classical Bouc–Wen model has no command input, so it cannot know that the damper's force follows the \
          command voltage Y. `diagnose` is given D and F only; Y and A are auxiliary channels it may use.",
     );
-    hil_sim::diagnose::report::section(&mut rep, &a.out, "diagnose_ranran50", &diag, ("D", "F"))?;
+    hil_sim::ident::diagnose::report::section(&mut rep, &a.out, "diagnose_ranran50", &diag, ("D", "F"))?;
     text += &format!("\ndiagnosis of ranran_50.csv from bouc_wen (no --command):\n{}", super::diagnose::text(&diag));
 
     // 5. The fixed-step core against f64 references (short runs).

@@ -2,7 +2,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use hil_sim::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
+use hil_sim::ident::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
 use hil_sim::fit::Dataset;
 use hil_sim::quality;
 use hil_sim::recording::Recording;
@@ -73,7 +73,7 @@ pub fn run(a: DiagnoseArgs) -> anyhow::Result<()> {
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         let mut rep = hil_sim::report::Report::new(format!("Diagnosis of {}", a.rec.display()));
-        hil_sim::diagnose::report::section(&mut rep, dir, "diagnose", &d, (&a.ch.input, &a.ch.output))?;
+        hil_sim::ident::diagnose::report::section(&mut rep, dir, "diagnose", &d, (&a.ch.input, &a.ch.output))?;
         let index = rep.write(dir)?;
         eprintln!("report written to {}", index.display());
     }

@@ -2,7 +2,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use hil_sim::concealed::{generate, ConcealedSpec};
+use hil_sim::sim::concealed::{generate, ConcealedSpec};
 use hil_sim::scenario::{Quantity, Scenario, BUILTIN};
 use serde_json::json;
 

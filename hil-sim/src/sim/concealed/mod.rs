@@ -45,7 +45,7 @@ use rand_distr::{Distribution, Normal};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::diagnose::augment::Transform;
+use crate::ident::diagnose::augment::Transform;
 
 /// Every effect `generate` can conceal (`none`: a null recording).
 pub const EFFECTS: &[&str] = &[

@@ -1,0 +1,3 @@
+//! Identification: what a recording says about the clutch.
+
+pub mod diagnose;

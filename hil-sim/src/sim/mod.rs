@@ -1,0 +1,3 @@
+//! Simulation: recordings made from the models.
+
+pub mod concealed;
