@@ -166,6 +166,24 @@ impl Recording {
             .collect()
     }
 
+    /// Write the recording as CSV: a header naming the columns and then the constants,
+    /// one row per sample, each constant on the first row only (as [`Recording::parse_csv`]
+    /// reads it back). Values are written in full (the shortest text that reads back to the
+    /// same number).
+    pub fn write_csv(&self, w: impl std::io::Write) -> std::io::Result<()> {
+        let mut out = csv::Writer::from_writer(w);
+        let names = self.columns.iter().map(|c| c.name.as_str()).chain(self.constants.iter().map(|c| c.0.as_str()));
+        out.write_record(names)?;
+        let mut row: Vec<String> = Vec::with_capacity(self.columns.len() + self.constants.len());
+        for k in 0..self.len() {
+            row.clear();
+            row.extend(self.columns.iter().map(|c| c.values.get(k).map_or_else(String::new, f64::to_string)));
+            row.extend(self.constants.iter().map(|c| if k == 0 { c.1.to_string() } else { String::new() }));
+            out.write_record(&row)?;
+        }
+        out.flush()
+    }
+
     /// Read a CSV recording.
     pub fn read_csv(path: &Path) -> Result<Self, RecordingError> {
         let bytes = std::fs::read(path).map_err(|source| RecordingError::Io { path: path.to_path_buf(), source })?;

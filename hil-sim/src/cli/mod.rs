@@ -10,6 +10,7 @@ mod export;
 mod fit;
 mod loop_cmd;
 mod models;
+mod progress;
 mod replay;
 mod simulate;
 
