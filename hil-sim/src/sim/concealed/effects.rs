@@ -170,3 +170,26 @@ fn term(effect: &str, truth: &Truth) -> Option<(&'static str, Vec<f64>)> {
         _ => return None,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_input_effects_do_what_their_physics_says() {
+        let dt = 1e-3;
+        let x: Vec<f64> = (0..200).map(|i| (i as f64 * 0.05).sin()).collect();
+        // A delay of 2.5 samples: halfway between the samples 2 and 3 earlier; the start held.
+        let d = delay(&x, 2.5e-3, dt);
+        assert!((d[50] - 0.5 * (x[47] + x[48])).abs() < 1e-12);
+        assert_eq!(d[0], x[0]);
+        assert_eq!(delay(&x, 0.0, dt), x);
+        // The lag's step response is 1 − e^{−t/τ} at the samples (exact discretisation).
+        let step: Vec<f64> = (0..100).map(|i| if i < 10 { 0.0 } else { 1.0 }).collect();
+        let l = lag(&step, 5e-3, dt);
+        assert!((l[14] - (1.0 - (-5.0f64 / 5.0).exp())).abs() < 1e-9, "{}", l[14]);
+        assert_eq!(lag(&x, 0.0, dt), x);
+        let s = saturate(&[2.0, -2.0, 0.0], 0.5);
+        assert!(s[0] < 0.5 && s[0] > 0.49 && s[1] == -s[0] && s[2] == 0.0);
+    }
+}
