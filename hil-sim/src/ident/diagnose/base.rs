@@ -9,7 +9,7 @@ use crate::fit::spec::{ModelSpec, Strategy};
 use crate::fit::{fit, Dataset, DelayChoice, FitOptions, FitResult};
 use crate::progress::Progress;
 
-/// The seed models `--model auto` chooses among: every parametric model of the papers
+/// The seed models `auto` (no base model given) chooses among: every parametric model of the papers
 /// (the operator and data-driven models describe a loop without naming physics).
 pub const AUTO_BASES: &[&str] =
     &["algebraic", "bouc_wen", "lugre", "tanh", "dahl", "spencer", "bingham", "arctan", "arctan_inertia", "trig"];

@@ -3,7 +3,7 @@
 //! refit did not see.
 //!
 //! 1. **Base** ([`base`]). The base model is fitted on the training part (the first
-//!    `1 − heldout_fraction`) with the channels as recorded (`--delay off`: a time shift
+//!    `1 − heldout_fraction`) with the channels as recorded (no delay fitted: a time shift
 //!    between channels is a finding, not something to absorb silently). `auto` fits every
 //!    seed model ([`AUTO_BASES`]) and keeps the best held-out one.
 //! 2. **Locate** ([`locate`]). The base residual's energy over time (windows), over the

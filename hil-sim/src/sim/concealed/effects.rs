@@ -17,8 +17,8 @@
 
 use std::collections::BTreeMap;
 
+use super::spec::{ConcealedError, ConcealedSpec};
 use super::truth::{rms, torque, Truth};
-use super::{ConcealedError, ConcealedSpec};
 
 /// A first-order lag `τ·ẏ = x − y` of `x` (sample interval `dt`, s), starting at `x[0]`;
 /// `τ ≤ 0` passes `x` through.

@@ -8,7 +8,7 @@ use std::f64::consts::PI;
 
 use rand::Rng;
 
-use super::{ConcealedError, ConcealedSpec};
+use super::spec::{ConcealedError, ConcealedSpec};
 
 /// Eddy-current time constant between coil current and field, s.
 const TAU_EDDY_S: f64 = 0.002;
