@@ -9,13 +9,13 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use hil_sim::ident::diagnose::{diagnose, DiagnoseOptions};
 use hil_sim::ident::fit::Dataset;
 use hil_sim::io::recording::Channels;
-use hil_sim::io::recording::Recording;
+use hil_sim::progress::NoProgress;
 use hil_sim::sim::concealed::{generate, ConcealedSpec};
 
 fn bench(c: &mut Criterion) {
     let spec = ConcealedSpec { effect: "field_lag".into(), base: "bouc_wen".into(), ..ConcealedSpec::default() };
     let g = generate(&spec).expect("concealed recording");
-    let rec = Recording::parse_csv(std::path::Path::new("field_lag.csv"), g.csv.as_bytes()).expect("csv");
+    let rec = g.recording;
     let ch = Channels::default();
     let data = Dataset::new(&rec, &ch, 0.7, None).expect("dataset");
     assert_eq!(data.len(), 60_000);
@@ -25,10 +25,7 @@ fn bench(c: &mut Criterion) {
     for (name, model) in [("bouc_wen_30s_2khz", Some("bouc_wen")), ("auto_30s_2khz", None)] {
         let opts = DiagnoseOptions { model: model.map(str::to_owned), ..DiagnoseOptions::default() };
         group.bench_function(name, |b| {
-            b.iter(|| {
-                diagnose(&data, aux.clone(), None, ("b", "torque"), &opts, &indicatif::ProgressBar::hidden())
-                    .expect("diagnosis")
-            })
+            b.iter(|| diagnose(&data, aux.clone(), None, ("b", "torque"), &opts, &NoProgress).expect("diagnosis"))
         });
     }
     group.finish();

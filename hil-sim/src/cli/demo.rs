@@ -174,24 +174,17 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
 
     // 4. A diagnosis: the damper file through a model that ignores the command voltage.
     eprintln!("diagnosing ranran_50.csv from bouc_wen without the command channel");
-    let diag_args = super::diagnose::DiagnoseArgs {
-        rec: hil_sim::io::bundled::data_file("dyke/ranran_50.csv").map_err(anyhow::Error::msg)?,
-        model: "bouc_wen".into(),
+    let diag_rec = hil_sim::io::bundled::data_file("dyke/ranran_50.csv").map_err(anyhow::Error::msg)?;
+    let diag_ch =
+        hil_sim::io::recording::Channels { time: "t".into(), input: "D".into(), output: "F".into(), command: None };
+    let diag_opts = hil_sim::ident::diagnose::DiagnoseOptions {
+        model: Some("bouc_wen".into()),
         heldout: 0.3,
-        ch: super::ChannelArgs {
-            time: "t".into(),
-            input: "D".into(),
-            output: "F".into(),
-            command: None,
-            rate: "auto".into(),
-            keep_flagged: false,
-        },
-        max_findings: 3,
+        rate: None,
         seed: 1,
-        out: None,
-        json: false,
+        max_findings: 3,
     };
-    let (diag, _) = super::diagnose::run_diagnosis(&diag_args)?;
+    let (diag, _) = super::diagnose::run_diagnosis(&diag_rec, &diag_ch, false, &diag_opts)?;
     rep.heading("Diagnosis: what Bouc–Wen misses on ranran_50.csv (`hil-sim diagnose --model bouc_wen`)");
     rep.paragraph(
         "The classical Bouc–Wen model has no command input, so it cannot know that the damper's force follows the \

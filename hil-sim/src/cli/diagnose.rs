@@ -1,12 +1,14 @@
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
-use hil_sim::ident::diagnose::{diagnose, DiagnoseOptions, Diagnosis};
+use hil_sim::ident::diagnose::{diagnose, DiagnoseError, DiagnoseOptions, Diagnosis};
 use hil_sim::ident::fit::Dataset;
+use hil_sim::io::recording::Channels;
 use hil_sim::io::recording::Recording;
 use hil_sim::quality;
 
+use super::progress::Bar;
 use super::ChannelArgs;
 
 #[derive(Args, Debug)]
@@ -34,42 +36,56 @@ pub struct DiagnoseArgs {
     pub json: bool,
 }
 
-/// Read, check and diagnose a recording; shared with the demo.
-pub fn run_diagnosis(a: &DiagnoseArgs) -> anyhow::Result<(Diagnosis, Dataset)> {
-    if !(0.05..=0.8).contains(&a.heldout) {
-        anyhow::bail!("--heldout {}: must be between 0.05 and 0.8", a.heldout);
+/// The library's error with the flag that set the offending value.
+fn flagged(e: DiagnoseError) -> anyhow::Error {
+    match e {
+        DiagnoseError::Heldout(v) => anyhow::anyhow!("--heldout {v}: must be between 0.05 and 0.8"),
+        e => e.into(),
     }
-    if a.model != "auto" {
-        super::fit::model_list(&a.model)?;
-        if a.model.contains(',') {
-            anyhow::bail!("--model {}: one base model (or `auto`)", a.model);
-        }
-    }
-    let path = super::file_arg(&a.rec)?;
+}
+
+/// Read, check and diagnose the recording at `rec` (channels `ch`; samples the quality
+/// check flags left out unless `keep_flagged`); shared with the demo.
+pub fn run_diagnosis(
+    rec: &Path,
+    ch: &Channels,
+    keep_flagged: bool,
+    opts: &DiagnoseOptions,
+) -> anyhow::Result<(Diagnosis, Dataset)> {
+    opts.check().map_err(flagged)?;
+    let path = super::file_arg(rec)?;
     let rec = Recording::read(&path)?;
-    let ch = a.ch.channels();
-    let q = quality::check(&rec, &ch)?;
+    let q = quality::check(&rec, ch)?;
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
     }
-    let excluded = (!a.ch.keep_flagged).then(|| q.excluded());
-    let data = Dataset::new(&rec, &ch, 1.0 - a.heldout, excluded).with_context(|| format!("{}", path.display()))?;
-    let aux = rec.auxiliary_channels(&ch);
-    let opts = DiagnoseOptions {
-        model: (a.model != "auto").then(|| a.model.clone()),
-        heldout: a.heldout,
-        rate: a.ch.rate()?,
-        seed: a.seed,
-        max_findings: a.max_findings,
-    };
-    let pb = super::progress(1, "diagnosing");
-    let d = diagnose(&data, aux, ch.command.as_deref(), (&ch.input, &ch.output), &opts, &pb)
-        .with_context(|| format!("diagnosing {}", path.display()))?;
+    let excluded = (!keep_flagged).then(|| q.excluded());
+    let data = Dataset::new(&rec, ch, 1.0 - opts.heldout, excluded).with_context(|| format!("{}", path.display()))?;
+    let aux = rec.auxiliary_channels(ch);
+    let bar = Bar::new(1, "diagnosing");
+    let d = diagnose(&data, aux, ch.command.as_deref(), (&ch.input, &ch.output), opts, &bar);
+    bar.finish();
+    let d = d.map_err(flagged).with_context(|| format!("diagnosing {}", path.display()))?;
     Ok((d, data))
 }
 
 pub fn run(a: DiagnoseArgs) -> anyhow::Result<()> {
-    let (d, _) = run_diagnosis(&a)?;
+    let opts = DiagnoseOptions {
+        model: (a.model != "auto").then(|| a.model.clone()),
+        heldout: a.heldout,
+        rate: None,
+        seed: a.seed,
+        max_findings: a.max_findings,
+    };
+    opts.check().map_err(flagged)?;
+    if let Some(m) = &opts.model {
+        super::fit::model_list(m)?;
+        if m.contains(',') {
+            anyhow::bail!("--model {m}: one base model (or `auto`)");
+        }
+    }
+    let opts = DiagnoseOptions { rate: a.ch.rate()?, ..opts };
+    let (d, _) = run_diagnosis(&a.rec, &a.ch.channels(), a.ch.keep_flagged, &opts)?;
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         let mut rep = hil_sim::report::Report::new(format!("Diagnosis of {}", a.rec.display()));

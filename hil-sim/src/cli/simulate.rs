@@ -2,7 +2,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use hil_sim::sim::concealed::{generate, ConcealedSpec};
+use hil_sim::sim::concealed::{generate, ConcealedError, ConcealedSpec};
 use hil_sim::sim::scenario::{Quantity, Scenario, BUILTIN};
 use serde_json::json;
 
@@ -54,6 +54,31 @@ fn write(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
     std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
 }
 
+/// Create `path`'s folder and write `path` with `write`.
+fn write_with(
+    path: &std::path::Path,
+    write: impl FnOnce(std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+) -> anyhow::Result<()> {
+    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    let file = std::fs::File::create(path).with_context(|| format!("writing {}", path.display()))?;
+    write(std::io::BufWriter::new(file)).with_context(|| format!("writing {}", path.display()))
+}
+
+/// The generator's error with the flags that set the offending values.
+fn flagged(e: ConcealedError) -> anyhow::Error {
+    match e {
+        ConcealedError::Size(v) => {
+            anyhow::anyhow!("--size {v}: must be between 0 and 0.5 (a fraction of the torque span)")
+        }
+        ConcealedError::Length(d, fs) => {
+            anyhow::anyhow!("--duration {d} s at --fs {fs} Hz: need at least 2 s and 200 Hz, at most 10^7 samples")
+        }
+        e => e.into(),
+    }
+}
+
 fn run_concealed(a: &SimulateArgs, effect: &str) -> anyhow::Result<()> {
     let spec = ConcealedSpec {
         effect: effect.to_owned(),
@@ -65,9 +90,10 @@ fn run_concealed(a: &SimulateArgs, effect: &str) -> anyhow::Result<()> {
         fs_hz: a.fs,
     };
     let pb = super::progress(1, "generating");
-    let g = generate(&spec)?;
+    let g = generate(&spec);
     pb.finish_and_clear();
-    write(&a.out, &g.csv)?;
+    let g = g.map_err(flagged)?;
+    write_with(&a.out, |w| g.recording.write_csv(w))?;
     if let Some(l) = &a.label {
         write(l, &(serde_json::to_string_pretty(&g.label)? + "\n"))?;
     }

@@ -23,6 +23,7 @@ use crate::ident::fit::simulate::{kinematics, Simulator};
 use crate::ident::fit::Dataset;
 use crate::models::search::{ModelSpec, Spacing};
 use crate::models::RateSpec;
+use crate::numerics::lstsq;
 
 /// A change to what the base model is fed.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -281,22 +282,13 @@ impl Problem<'_> {
             for (r, (c, s)) in row.iter_mut().zip(columns.iter().zip(&norms)) {
                 *r = c[i] / s;
             }
-            let t = target[i];
-            for a in 0..k {
-                let ra = row[a];
-                b[a] += ra * t;
-                for c in a..k {
-                    g[(a, c)] += ra * row[c];
-                }
-            }
+            lstsq::accumulate(&mut g, &mut b, &row, target[i]);
         }
+        lstsq::symmetrize(&mut g);
         for a in 0..k {
-            for c in 0..a {
-                g[(a, c)] = g[(c, a)];
-            }
             g[(a, a)] += 1e-10;
         }
-        let sol = g.clone().cholesky().map(|ch| ch.solve(&b)).or_else(|| g.svd(true, true).solve(&b, 1e-12).ok())?;
+        let sol = lstsq::solve_cholesky(g, &b, 1e-12)?;
         let coef: Vec<f64> = sol.iter().zip(&norms).map(|(v, s)| v / s).collect();
         if coef.iter().any(|v| !v.is_finite()) {
             return None;

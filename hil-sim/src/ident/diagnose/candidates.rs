@@ -16,7 +16,7 @@
 
 use serde::Serialize;
 
-use super::augment::{Term, Transform};
+use super::augment::{Fitted, Term, Transform};
 use crate::ident::fit::Dataset;
 
 /// What an auxiliary channel was taken to be.
@@ -171,103 +171,152 @@ fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     (0..n).map(|k| lo * (hi / lo).powf(k as f64 / (n - 1).max(1) as f64)).collect()
 }
 
+/// The input's statistics the candidates' grids and terms are built from.
+struct InputStats {
+    dt: f64,
+    x: Vec<f64>,
+    dx: Vec<f64>,
+    ddx: Vec<f64>,
+    /// Largest |x|, the span of x and its mean.
+    x_max: f64,
+    x_span: f64,
+    x_mean: f64,
+    /// Standard deviation of the rate.
+    dx_std: f64,
+}
+
+impl InputStats {
+    fn of(data: &Dataset) -> Self {
+        let x = data.input.clone();
+        let (dx, ddx) = rates(data);
+        let x_max = x.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
+        let x_span = {
+            let (lo, hi) = x.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+            (hi - lo).max(1e-300)
+        };
+        let x_mean = mean(&x);
+        let dx_std = std(&dx).max(1e-300);
+        Self { dt: data.dt, x, dx, ddx, x_max, x_span, x_mean, dx_std }
+    }
+}
+
+/// A candidate with one term and no grid.
+fn additive(
+    effect: &'static str,
+    label: String,
+    name: &'static str,
+    v: Vec<f64>,
+    channel: Option<String>,
+) -> Candidate {
+    Candidate {
+        effect,
+        label,
+        grid_name: None,
+        grid: vec![0.0],
+        build: Box::new(move |_| Piece { transform: None, terms: vec![Term::additive(name, v.clone())] }),
+        channel,
+    }
+}
+
 /// Every candidate for this recording.
 pub fn all(data: &Dataset, aux: &[AuxChannel]) -> Vec<Candidate> {
-    let dt = data.dt;
-    let fs = 1.0 / dt;
-    let x = data.input.clone();
-    let (dx, ddx) = rates(data);
-    let x_max = x.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
-    let x_span = {
-        let (lo, hi) = x.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
-        (hi - lo).max(1e-300)
-    };
-    let x_mean = mean(&x);
-    let dx_std = std(&dx).max(1e-300);
-    let mut out = Vec::new();
+    let s = InputStats::of(data);
+    let mut out = input_transforms(&s);
+    out.extend(kinematic_terms(&s, aux));
+    out.extend(thermal(data, &s, aux));
+    for c in aux.iter().filter(|a| a.role == Role::Speed) {
+        out.extend(speed(&s, c));
+    }
+    for a in aux.iter().filter(|a| a.role == Role::Auxiliary) {
+        out.push(auxiliary(&s, a));
+    }
+    out
+}
 
-    // Phase: a first-order lag and a pure delay, 1 sample to 50 ms.
-    out.push(Candidate {
-        effect: "field_lag",
-        label: "first-order lag of the input".into(),
-        grid_name: Some("tau_s".into()),
-        grid: log_grid(dt, (0.05f64).max(4.0 * dt), 14),
-        build: Box::new(|tau| Piece { transform: Some(Transform::Lag { tau_s: tau }), terms: vec![] }),
-        channel: None,
-    });
+/// Phase (a first-order lag and a pure delay, 1 sample to 50 ms) and amplitude (a
+/// saturating map and a zero offset): transforms of the input the base model is fed.
+fn input_transforms(s: &InputStats) -> Vec<Candidate> {
+    let dt = s.dt;
+    let fs = 1.0 / dt;
     let max_delay = (0.02 * fs).round().clamp(4.0, 40.0);
-    out.push(Candidate {
-        effect: "transport_delay",
-        label: "time shift between input and output".into(),
-        grid_name: Some("delay_s".into()),
-        grid: (-(max_delay as i64)..=max_delay as i64).filter(|k| *k != 0).map(|k| k as f64 * dt).collect(),
-        build: Box::new(|d| Piece { transform: Some(Transform::Delay { delay_s: d }), terms: vec![] }),
-        channel: None,
-    });
-    // Amplitude: a saturating map and a zero offset of the input.
-    out.push(Candidate {
-        effect: "saturation",
-        label: "saturating map of the input".into(),
-        grid_name: Some("b_sat".into()),
-        grid: log_grid(0.6 * x_max, 6.0 * x_max, 10),
-        build: Box::new(|b| Piece { transform: Some(Transform::Saturate { b_sat: b }), terms: vec![] }),
-        channel: None,
-    });
-    out.push(Candidate {
-        effect: "sensor_offset",
-        label: "zero offset of the input".into(),
-        grid_name: Some("b_0".into()),
-        grid: (-8..=8).filter(|k| *k != 0).map(|k| f64::from(k) * 0.01 * x_span).collect(),
-        build: Box::new(|b| Piece { transform: Some(Transform::Offset { b_0: b }), terms: vec![] }),
-        channel: None,
-    });
-    // Rate: c·|ẋ|ẋ.
-    let rate_term: Vec<f64> = dx.iter().map(|v| v.abs() * v).collect();
-    out.push(Candidate {
-        effect: "rate_dependence",
-        label: "term in |rate|·rate".into(),
-        grid_name: None,
-        grid: vec![0.0],
-        build: Box::new(move |_| Piece { transform: None, terms: vec![Term::additive("c_rate", rate_term.clone())] }),
-        channel: None,
-    });
-    // Direction: δ·(x − x̄)·sgn(ẋ), the sign smoothed over 5 % of the rate's spread.
-    let asym: Vec<f64> = x.iter().zip(&dx).map(|(x, d)| (x - x_mean) * (d / (0.05 * dx_std)).tanh()).collect();
-    out.push(Candidate {
-        effect: "asymmetry",
-        label: "loading/unloading difference growing with the input".into(),
-        grid_name: None,
-        grid: vec![0.0],
-        build: Box::new(move |_| Piece { transform: None, terms: vec![Term::additive("delta", asym.clone())] }),
-        channel: None,
-    });
-    // Inertia: m·ẍ, from a measured acceleration when there is one.
+    vec![
+        Candidate {
+            effect: "field_lag",
+            label: "first-order lag of the input".into(),
+            grid_name: Some("tau_s".into()),
+            grid: log_grid(dt, (0.05f64).max(4.0 * dt), 14),
+            build: Box::new(|tau| Piece { transform: Some(Transform::Lag { tau_s: tau }), terms: vec![] }),
+            channel: None,
+        },
+        Candidate {
+            effect: "transport_delay",
+            label: "time shift between input and output".into(),
+            grid_name: Some("delay_s".into()),
+            grid: (-(max_delay as i64)..=max_delay as i64).filter(|k| *k != 0).map(|k| k as f64 * dt).collect(),
+            build: Box::new(|d| Piece { transform: Some(Transform::Delay { delay_s: d }), terms: vec![] }),
+            channel: None,
+        },
+        Candidate {
+            effect: "saturation",
+            label: "saturating map of the input".into(),
+            grid_name: Some("b_sat".into()),
+            grid: log_grid(0.6 * s.x_max, 6.0 * s.x_max, 10),
+            build: Box::new(|b| Piece { transform: Some(Transform::Saturate { b_sat: b }), terms: vec![] }),
+            channel: None,
+        },
+        Candidate {
+            effect: "sensor_offset",
+            label: "zero offset of the input".into(),
+            grid_name: Some("b_0".into()),
+            grid: (-8..=8).filter(|k| *k != 0).map(|k| f64::from(k) * 0.01 * s.x_span).collect(),
+            build: Box::new(|b| Piece { transform: Some(Transform::Offset { b_0: b }), terms: vec![] }),
+            channel: None,
+        },
+    ]
+}
+
+/// Rate (`c·|ẋ|ẋ`), direction (`δ·(x − x̄)·sgn(ẋ)`, the sign smoothed over 5 % of the
+/// rate's spread) and inertia (`m·ẍ`, from a measured acceleration when there is one).
+fn kinematic_terms(s: &InputStats, aux: &[AuxChannel]) -> Vec<Candidate> {
+    let rate_term: Vec<f64> = s.dx.iter().map(|v| v.abs() * v).collect();
+    let asym: Vec<f64> = s.x.iter().zip(&s.dx).map(|(x, d)| (x - s.x_mean) * (d / (0.05 * s.dx_std)).tanh()).collect();
     let acc = aux.iter().find(|a| a.role == Role::InputAcceleration);
     let (acc_values, acc_label, acc_channel) = match acc {
         Some(a) => {
             (centred(&a.values), format!("inertial term m·{} (measured acceleration)", a.name), Some(a.name.clone()))
         }
-        None => (ddx.clone(), "inertial term m·ẍ of the input".into(), None),
+        None => (s.ddx.clone(), "inertial term m·ẍ of the input".into(), None),
     };
-    out.push(Candidate {
-        effect: "inertia",
-        label: acc_label,
+    vec![
+        additive("rate_dependence", "term in |rate|·rate".into(), "c_rate", rate_term, None),
+        additive("asymmetry", "loading/unloading difference growing with the input".into(), "delta", asym, None),
+        additive("inertia", acc_label, "m", acc_values, acc_channel),
+    ]
+}
+
+/// Thermal drift: a temperature channel scales the model (and shifts its offset); without
+/// one, the dissipated energy does.
+fn thermal(data: &Dataset, s: &InputStats, aux: &[AuxChannel]) -> Vec<Candidate> {
+    let temps: Vec<&AuxChannel> = aux.iter().filter(|a| a.role == Role::Temperature).collect();
+    let drift = |label: String, (kappa, offset): (&'static str, &'static str), v: Vec<f64>, channel| Candidate {
+        effect: "thermal_drift",
+        label,
         grid_name: None,
         grid: vec![0.0],
-        build: Box::new(move |_| Piece { transform: None, terms: vec![Term::additive("m", acc_values.clone())] }),
-        channel: acc_channel,
-    });
-    // Thermal drift: a temperature channel scales the model (and shifts its offset); without
-    // one, the dissipated energy does.
-    let temps: Vec<&AuxChannel> = aux.iter().filter(|a| a.role == Role::Temperature).collect();
+        build: Box::new(move |_| Piece {
+            transform: None,
+            terms: vec![Term::scaling(kappa, v.clone()), Term::additive(offset, v.clone())],
+        }),
+        channel,
+    };
     if temps.is_empty() {
         let energy = {
             let mut e = 0.0;
-            let p: Vec<f64> = data.output.iter().zip(&dx).map(|(y, d)| (y * d).abs()).collect();
+            let p: Vec<f64> = data.output.iter().zip(&s.dx).map(|(y, d)| (y * d).abs()).collect();
             let mut v: Vec<f64> = p
                 .iter()
                 .map(|p| {
-                    e += p * dt;
+                    e += p * s.dt;
                     e
                 })
                 .collect();
@@ -275,90 +324,84 @@ pub fn all(data: &Dataset, aux: &[AuxChannel]) -> Vec<Candidate> {
             v.iter_mut().for_each(|a| *a /= last);
             centred(&v)
         };
-        out.push(Candidate {
-            effect: "thermal_drift",
-            label: "drift with the dissipated energy".into(),
-            grid_name: None,
-            grid: vec![0.0],
-            build: Box::new(move |_| Piece {
-                transform: None,
-                terms: vec![
-                    Term::scaling("kappa_energy", energy.clone()),
-                    Term::additive("offset_energy", energy.clone()),
-                ],
-            }),
-            channel: None,
-        });
+        return vec![drift("drift with the dissipated energy".into(), ("kappa_energy", "offset_energy"), energy, None)];
     }
-    for t in temps {
-        let v = centred(&t.values);
-        out.push(Candidate {
-            effect: "thermal_drift",
-            label: format!("drift with the channel {} (a temperature)", t.name),
-            grid_name: None,
-            grid: vec![0.0],
-            build: Box::new(move |_| Piece {
-                transform: None,
-                terms: vec![Term::scaling("kappa_per_unit", v.clone()), Term::additive("offset_per_unit", v.clone())],
-            }),
-            channel: Some(t.name.clone()),
-        });
-    }
-    for s in aux.iter().filter(|a| a.role == Role::Speed) {
-        let v = centred(&s.values);
-        let vb: Vec<f64> = v.iter().zip(&x).map(|(v, x)| v * x / x_max).collect();
-        out.push(Candidate {
+    temps
+        .into_iter()
+        .map(|t| {
+            let label = format!("drift with the channel {} (a temperature)", t.name);
+            drift(label, ("kappa_per_unit", "offset_per_unit"), centred(&t.values), Some(t.name.clone()))
+        })
+        .collect()
+}
+
+/// A speed channel: a viscous term in it (alone and times the input) and the inertia of
+/// what it measures (`J·dω/dt`, the speed smoothed over 20 samples without delay).
+fn speed(s: &InputStats, c: &AuxChannel) -> Vec<Candidate> {
+    let dt = s.dt;
+    let v = centred(&c.values);
+    let vb: Vec<f64> = v.iter().zip(&s.x).map(|(v, x)| v * x / s.x_max).collect();
+    let tau = 20.0 * dt / (2.0 * std::f64::consts::PI);
+    let smooth = crate::models::alignment::shift(&lowpass(&c.values, tau, dt), tau / dt);
+    let acc = crate::numerics::derivative::gradient(&smooth, dt);
+    vec![
+        Candidate {
             effect: "slip_speed",
-            label: format!("viscous term in the channel {} (a speed)", s.name),
+            label: format!("viscous term in the channel {} (a speed)", c.name),
             grid_name: None,
             grid: vec![0.0],
             build: Box::new(move |_| Piece {
                 transform: None,
                 terms: vec![Term::additive("c_omega", v.clone()), Term::additive("c_omega_field", vb.clone())],
             }),
-            channel: Some(s.name.clone()),
-        });
-        let tau = 20.0 * dt / (2.0 * std::f64::consts::PI);
-        let smooth = crate::models::alignment::shift(&lowpass(&s.values, tau, dt), tau / dt);
-        let acc = crate::numerics::derivative::gradient(&smooth, dt);
-        out.push(Candidate {
-            effect: "inertia",
-            label: format!("inertial term J·d{}/dt", s.name),
-            grid_name: None,
-            grid: vec![0.0],
-            build: Box::new(move |_| Piece { transform: None, terms: vec![Term::additive("j", acc.clone())] }),
-            channel: Some(s.name.clone()),
-        });
+            channel: Some(c.name.clone()),
+        },
+        additive("inertia", format!("inertial term J·d{}/dt", c.name), "j", acc, Some(c.name.clone())),
+    ]
+}
+
+/// Any other varying channel: the model's parameters scaled by it, through a first-order
+/// lag whose time constant is the grid (0: none).
+fn auxiliary(s: &InputStats, a: &AuxChannel) -> Candidate {
+    let dt = s.dt;
+    let raw = a.values.clone();
+    let dx = s.dx.clone();
+    let xc: Vec<f64> = s.x.iter().map(|v| v - s.x_mean).collect();
+    let mut grid = vec![0.0];
+    grid.extend(log_grid(dt, (0.05f64).max(4.0 * dt), 10));
+    Candidate {
+        effect: "aux_dependence",
+        label: format!("parameters scaled by {}", a.name),
+        grid_name: Some("lag_s".into()),
+        grid,
+        build: Box::new(move |tau| {
+            let u = centred(&lowpass(&raw, tau, dt));
+            let udx: Vec<f64> = u.iter().zip(&dx).map(|(u, d)| u * d).collect();
+            let ux: Vec<f64> = u.iter().zip(&xc).map(|(u, x)| u * x).collect();
+            Piece {
+                transform: None,
+                terms: vec![
+                    Term::scaling("alpha", u.clone()),
+                    Term::additive("offset", u),
+                    Term::additive("c_rate", udx),
+                    Term::additive("k_input", ux),
+                ],
+            }
+        }),
+        channel: Some(a.name.clone()),
     }
-    for a in aux.iter().filter(|a| a.role == Role::Auxiliary) {
-        let raw = a.values.clone();
-        let dx = dx.clone();
-        let xc: Vec<f64> = x.iter().map(|v| v - x_mean).collect();
-        let mut grid = vec![0.0];
-        grid.extend(log_grid(dt, (0.05f64).max(4.0 * dt), 10));
-        out.push(Candidate {
-            effect: "aux_dependence",
-            label: format!("parameters scaled by {}", a.name),
-            grid_name: Some("lag_s".into()),
-            grid,
-            build: Box::new(move |tau| {
-                let u = centred(&lowpass(&raw, tau, dt));
-                let udx: Vec<f64> = u.iter().zip(&dx).map(|(u, d)| u * d).collect();
-                let ux: Vec<f64> = u.iter().zip(&xc).map(|(u, x)| u * x).collect();
-                Piece {
-                    transform: None,
-                    terms: vec![
-                        Term::scaling("alpha", u.clone()),
-                        Term::additive("offset", u),
-                        Term::additive("c_rate", udx),
-                        Term::additive("k_input", ux),
-                    ],
-                }
-            }),
-            channel: Some(a.name.clone()),
-        });
+}
+
+impl Candidate {
+    /// The transforms and terms of `current` with this candidate's piece at value `g` added.
+    pub fn on_top(&self, current: &Fitted, g: f64) -> (Vec<Transform>, Vec<Term>) {
+        let piece = (self.build)(g);
+        let mut transforms = current.transforms.clone();
+        transforms.extend(piece.transform);
+        let mut terms = current.terms.clone();
+        terms.extend(piece.terms);
+        (transforms, terms)
     }
-    out
 }
 
 #[cfg(test)]

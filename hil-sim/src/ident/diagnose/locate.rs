@@ -9,6 +9,8 @@ use rustfft::num_complex::Complex;
 use rustfft::FftPlanner;
 use serde::Serialize;
 
+use crate::ident::fit::Dataset;
+
 /// One operating condition where the energy concentrates.
 #[derive(Clone, Debug, Serialize)]
 pub struct Condition {
@@ -29,6 +31,66 @@ pub struct Band {
     pub hi_hz: f64,
     /// Root-mean-square of the signal within the band.
     pub rms: f64,
+}
+
+/// Where the base model's residual concentrates before anything is named.
+#[derive(Clone, Debug, Serialize)]
+pub struct Locate {
+    /// RMS of the base residual over the held-out part, output units.
+    pub residual_rms: f64,
+    /// Sample-to-sample noise floor of the residual (white-noise estimate), output units.
+    pub noise_rms: f64,
+    pub windows: Vec<(f64, f64)>,
+    pub conditions: Vec<Condition>,
+    pub bands: Vec<Band>,
+}
+
+/// Where the residual `y − base` of `data` concentrates over `rows` (time, operating
+/// conditions: the input's `rate` and the channels `aux`) and over frequency (the held-out
+/// part); `residual_rms` is its held-out RMS, as scored.
+pub fn residual(
+    data: &Dataset,
+    base: &[f64],
+    rows: &[usize],
+    rate: &[f64],
+    aux: &[(&str, &[f64])],
+    residual_rms: f64,
+) -> Locate {
+    let n = data.len();
+    let dt = data.dt;
+    let residual: Vec<f64> = data.output.iter().zip(base).map(|(y, m)| y - m).collect();
+    let mut energy: Vec<f64> = residual.iter().map(|r| r * r).collect();
+    mask(&mut energy, rows);
+    let noise_rms = {
+        let d2: Vec<f64> =
+            (1..n.saturating_sub(1)).map(|i| residual[i] - 0.5 * (residual[i - 1] + residual[i + 1])).collect();
+        (d2.iter().map(|v| v * v).sum::<f64>() / d2.len().max(1) as f64 / 1.5).sqrt()
+    };
+    let fs = 1.0 / dt;
+    let edges = band_edges(fs);
+    let held_residual: Vec<f64> = (data.train_end..n).map(|i| residual[i]).collect();
+    Locate {
+        residual_rms,
+        noise_rms,
+        windows: windows(&data.time, &energy, dt, 2.0, 5),
+        conditions: conditions(&data.input, rate, aux, &energy, rows).into_iter().take(5).collect(),
+        bands: spectrum(&held_residual, fs, &edges),
+    }
+}
+
+/// Zero the energy outside `rows`.
+pub fn mask(e: &mut [f64], rows: &[usize]) {
+    let mut keep = vec![false; e.len()];
+    for &i in rows {
+        if let Some(k) = keep.get_mut(i) {
+            *k = true;
+        }
+    }
+    for (v, k) in e.iter_mut().zip(keep) {
+        if !k {
+            *v = 0.0;
+        }
+    }
 }
 
 /// A centred moving average of `v` over `w` samples.

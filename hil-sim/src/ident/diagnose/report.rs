@@ -4,14 +4,16 @@
 
 use std::path::Path;
 
-use super::{locate, Diagnosis};
+use super::describe::unit_of;
+use super::diagnosis::Diagnosis;
+use super::locate;
 use crate::report::plot::{self, PlotError};
 use crate::report::Report;
 
 /// Add the diagnosis to `rep`, its plots written to `dir` as `<stem>_*.svg`.
 pub fn section(rep: &mut Report, dir: &Path, stem: &str, d: &Diagnosis, names: (&str, &str)) -> Result<(), PlotError> {
     let p = &d.plot;
-    let unit = |n: &str| super::unit_of(n).map(|u| format!(" ({u})")).unwrap_or_default();
+    let unit = |n: &str| unit_of(n).map(|u| format!(" ({u})")).unwrap_or_default();
     let (xl, yl) = (format!("{}{}", names.0, unit(names.0)), format!("{}{}", names.1, unit(names.1)));
     rep.paragraph(&format!(
         "Base model **{}** (fitted on the first {:.0} % with the channels as recorded), held-out R-RMSE {:.2} %, \

@@ -367,6 +367,20 @@ mod tests {
     }
 
     #[test]
+    fn written_csv_reads_back_the_same_values() {
+        let col = |name: &str, values: Vec<f64>| Column { name: name.into(), values };
+        let columns = vec![col("t", vec![0.0, 0.0005, 0.001]), col("b", vec![0.1 + 0.2, -1e-7, 12345.678901])];
+        let rec = Recording::from_columns(Path::new("mem"), columns, vec![("fs".into(), 2000.0)]);
+        let mut out = Vec::new();
+        rec.write_csv(&mut out).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        assert!(text.starts_with("t,b,fs\n0,0.30000000000000004,2000\n"), "{text}");
+        let back = parse(&text).unwrap();
+        assert_eq!(back.columns, rec.columns);
+        assert_eq!(back.constants, rec.constants);
+    }
+
+    #[test]
     fn reads_dyke_quirks() {
         let r = parse("\"t\",\"D\",\"fs\",\"F\",\n0,1.5,3004.8,10,\n0.1,1.6,,11,\n0.2,1.7,,12,\n").unwrap();
         assert_eq!(r.names(), vec!["t", "D", "F"]);

@@ -1,0 +1,80 @@
+//! Stage 4 of a diagnosis, modelling: in the round's ranking, the first candidate that
+//! lowers the training error, gains on the information criterion, passes the held-out
+//! block test ([`super::significance`]) and changes the prediction by more than the
+//! residual's noise floor resolves is kept; every candidate is recorded as tested.
+
+use super::augment::Fitted;
+use super::candidates::Candidate;
+use super::diagnosis::Tested;
+use super::rank::Scored;
+use super::significance::{self, Test};
+use crate::numerics::metrics::{metrics, Metrics};
+
+/// What a candidate is judged on: the recorded output, its held-out rows (the test), every
+/// scored row (the size of a term) and the residual's noise floor.
+pub struct Judge<'a> {
+    pub y: &'a [f64],
+    pub held: &'a [usize],
+    pub rows: &'a [usize],
+    pub noise_rms: f64,
+}
+
+/// The candidate kept in a round.
+pub struct Accepted {
+    pub scored: Scored,
+    pub test: Test,
+    pub after: Metrics,
+}
+
+/// A round's outcome: every candidate as tested and the one kept, if any.
+pub struct Verdict {
+    /// The reference's held-out metrics.
+    pub before: Metrics,
+    pub tested: Vec<Tested>,
+    pub accepted: Option<Accepted>,
+}
+
+impl Judge<'_> {
+    /// The metrics of the prediction `pred` on the held-out rows.
+    pub fn heldout(&self, pred: &[f64]) -> Metrics {
+        let pick = |v: &[f64]| -> Vec<f64> { self.held.iter().map(|&i| v[i]).collect() };
+        metrics(&pick(self.y), &pick(pred), None)
+    }
+
+    /// Judge the `ranked` candidates of round `round` (1-based) against `reference`.
+    pub fn round(&self, round: usize, cands: &[Candidate], reference: &Fitted, ranked: Vec<Scored>) -> Verdict {
+        let before = self.heldout(&reference.pred);
+        let mut tested = Vec::with_capacity(ranked.len());
+        let mut accepted = None;
+        for s in ranked {
+            let (c, f) = (&cands[s.index], &s.fitted);
+            let test = significance::test(self.y, &reference.pred, &f.pred, self.held);
+            let after = self.heldout(&f.pred);
+            // What the term changes in the prediction must be resolvable above the noise.
+            let change = (self.rows.iter().map(|&i| (f.pred[i] - reference.pred[i]).powi(2)).sum::<f64>()
+                / self.rows.len().max(1) as f64)
+                .sqrt();
+            let resolvable = change >= significance::MIN_TERM_OF_NOISE * self.noise_rms;
+            let kept = accepted.is_none()
+                && s.bic_gain > 0.0
+                && f.train_mse < reference.train_mse
+                && test.significant
+                && resolvable;
+            tested.push(Tested {
+                round,
+                effect: c.effect.to_owned(),
+                label: c.label.clone(),
+                value: c.grid_name.clone().map(|n| (n, s.value)),
+                bic_gain: s.bic_gain,
+                heldout_r_rmse_before: before.r_rmse,
+                heldout_r_rmse_after: after.r_rmse,
+                test,
+                kept,
+            });
+            if kept {
+                accepted = Some(Accepted { scored: s, test, after });
+            }
+        }
+        Verdict { before, tested, accepted }
+    }
+}

@@ -1,0 +1,93 @@
+//! Stage 1 of a diagnosis, the base model: fitted on the training part with the channels
+//! as recorded (`DelayChoice::Off`: a time shift between channels is a finding, not
+//! something to absorb silently). `auto` fits every seed model ([`AUTO_BASES`]) and keeps
+//! the one with the lowest held-out RMSE.
+
+use super::options::{DiagnoseError, DiagnoseOptions};
+use crate::ident::fit::simulate::Simulator;
+use crate::ident::fit::{fit, Dataset, DelayChoice, FitOptions, FitResult};
+use crate::models::search::{ModelSpec, Strategy};
+use crate::progress::Progress;
+
+/// The seed models `auto` (no base model given) chooses among: every parametric model of the papers
+/// (the operator and data-driven models describe a loop without naming physics).
+pub const AUTO_BASES: &[&str] =
+    &["algebraic", "bouc_wen", "lugre", "tanh", "dahl", "spencer", "bingham", "arctan", "arctan_inertia", "trig"];
+
+/// Levenberg–Marquardt iterations of the base model's fit.
+const LM_ITERATIONS: usize = 30;
+/// Rows this close to either end (s, plus two samples) are left out of the refits and the
+/// scores: delays and filters read past the ends.
+const MARGIN_S: f64 = 0.02;
+
+/// The fitted base model and what its refits need.
+pub struct Base {
+    pub fit: FitResult,
+    /// Every base model fitted, with its held-out R-RMSE.
+    pub tried: Vec<(String, f64)>,
+    pub sim: Box<dyn Simulator>,
+    pub spec: ModelSpec,
+}
+
+/// The base models to try: the one asked for, or [`AUTO_BASES`].
+pub fn choices(opts: &DiagnoseOptions) -> Vec<&str> {
+    match &opts.model {
+        Some(m) => vec![m.as_str()],
+        None => AUTO_BASES.to_vec(),
+    }
+}
+
+/// Fit every base of `bases` (one progress step each) and keep the best held-out one.
+pub fn fit_base(
+    data: &Dataset,
+    bases: &[&str],
+    opts: &DiagnoseOptions,
+    progress: &dyn Progress,
+) -> Result<Base, DiagnoseError> {
+    let fit_opts = FitOptions {
+        rate: opts.rate,
+        delay: DelayChoice::Off,
+        swarm: crate::ident::fit::global::SwarmOptions { seed: opts.seed, ..Default::default() },
+        lm_iterations: LM_ITERATIONS,
+        ..Default::default()
+    };
+    let mut fits: Vec<FitResult> = Vec::new();
+    let mut errors = Vec::new();
+    for id in bases {
+        progress.message(&format!("fitting {id}"));
+        match fit(id, data, &fit_opts) {
+            Ok(r) => fits.push(r),
+            Err(e) if opts.model.is_some() => return Err(e.into()),
+            Err(e) => errors.push(format!("{id}: {e}")),
+        }
+        progress.advance(1);
+    }
+    let score = |r: &FitResult| r.heldout_unflagged.unwrap_or(r.heldout).rmse;
+    let tried: Vec<(String, f64)> =
+        fits.iter().map(|r| (r.model.clone(), r.heldout_unflagged.unwrap_or(r.heldout).r_rmse)).collect();
+    let best = fits
+        .into_iter()
+        .filter(|r| score(r).is_finite())
+        .min_by(|a, b| score(a).total_cmp(&score(b)))
+        .ok_or_else(|| DiagnoseError::NoBase(errors.join("; ")))?;
+    let id = best.model.clone();
+    let sim = crate::ident::fit::simulate::simulator(&id, data.dt as f32)
+        .ok_or_else(|| DiagnoseError::NotParametric(id.clone()))?;
+    let spec = crate::models::host(&id)
+        .and_then(|h| h.spec(&data.scales(), Some(best.rate_choice)))
+        .ok_or_else(|| DiagnoseError::NotParametric(id.clone()))?;
+    if !matches!(spec.strategy, Strategy::Linear | Strategy::Local | Strategy::Global) {
+        return Err(DiagnoseError::NotParametric(id));
+    }
+    Ok(Base { fit: best, tried, sim, spec })
+}
+
+/// The training and held-out (unflagged) rows away from the ends.
+pub fn rows(data: &Dataset) -> (Vec<usize>, Vec<usize>) {
+    let n = data.len();
+    let margin = (MARGIN_S / data.dt).ceil() as usize + 2;
+    let inside = |i: &usize| *i >= margin && *i + margin < n;
+    let train = data.train_rows().into_iter().filter(inside).collect();
+    let held = data.heldout_unflagged().into_iter().filter(inside).collect();
+    (train, held)
+}

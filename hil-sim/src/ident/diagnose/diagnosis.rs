@@ -1,0 +1,97 @@
+//! What a diagnosis returns: the findings (which physics, how big, where, the held-out
+//! error before and after), every candidate tested, where the base residual concentrates
+//! and what the report plots.
+
+use std::collections::BTreeMap;
+
+use serde::Serialize;
+
+use super::candidates::AuxChannel;
+use super::locate::{Condition, Locate};
+use super::significance::Test;
+use crate::numerics::metrics::Metrics;
+
+/// One piece of missing physics, in the contract's shape.
+#[derive(Clone, Debug, Serialize)]
+pub struct Finding {
+    pub effect: String,
+    pub summary: String,
+    /// Where the gain concentrates, seconds.
+    pub windows: Vec<(f64, f64)>,
+    /// Fitted values of the term (units in the names or in `units`).
+    pub params: BTreeMap<String, f64>,
+    /// Units of `params` entries whose name does not carry one.
+    pub units: BTreeMap<String, String>,
+    pub heldout_before: Metrics,
+    pub heldout_after: Metrics,
+    /// Operating conditions where the gain concentrates, strongest first.
+    #[serde(rename = "where")]
+    pub conditions: Vec<Condition>,
+    /// The candidate as tested (label, channel, test outcome, size).
+    pub evidence: Evidence,
+}
+
+/// How a candidate fared.
+#[derive(Clone, Debug, Serialize)]
+pub struct Evidence {
+    pub label: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub channel: Option<String>,
+    pub test: Test,
+    /// RMS of what the term changes in the prediction, output units, and as a share of the
+    /// output's span.
+    pub term_rms: f64,
+    pub term_share_of_span: f64,
+    /// Training-part information criterion gain (positive: better).
+    pub bic_gain: f64,
+}
+
+/// A candidate tested in one round.
+#[derive(Clone, Debug, Serialize)]
+pub struct Tested {
+    pub round: usize,
+    pub effect: String,
+    pub label: String,
+    /// The candidate's grid value (`tau_s`, `delay_s`, …) where it has one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub value: Option<(String, f64)>,
+    pub bic_gain: f64,
+    pub heldout_r_rmse_before: f64,
+    pub heldout_r_rmse_after: f64,
+    pub test: Test,
+    pub kept: bool,
+}
+
+/// The whole diagnosis.
+#[derive(Clone, Debug, Serialize)]
+pub struct Diagnosis {
+    pub base_model: String,
+    pub heldout_fraction: f64,
+    pub findings: Vec<Finding>,
+    /// The base model as fitted, held-out part.
+    pub base_heldout: Metrics,
+    /// The model with every finding's term, held-out part.
+    pub final_heldout: Metrics,
+    /// Base models tried by `auto`, with their held-out R-RMSE.
+    pub bases_tried: Vec<(String, f64)>,
+    pub locate: Locate,
+    pub channels: Vec<AuxChannel>,
+    pub candidates: Vec<Tested>,
+    pub seconds: f64,
+    #[serde(skip)]
+    pub plot: PlotData,
+}
+
+/// What the report draws.
+#[derive(Clone, Debug, Default)]
+pub struct PlotData {
+    pub time: Vec<f64>,
+    pub input: Vec<f64>,
+    pub output: Vec<f64>,
+    /// The base model as fitted and the final model.
+    pub before: Vec<f64>,
+    pub after: Vec<f64>,
+    pub train_end: usize,
+    pub heldout_rows: Vec<usize>,
+    pub fs: f64,
+}

@@ -1,0 +1,78 @@
+//! One round's ranking of the candidates: each refitted on top of the reference (the
+//! current model refitted with the same iterations, so that a gain is never the extra
+//! Gauss–Newton steps) and scored by the Bayesian information criterion on the training
+//! part, `BIC = n·ln(MSE) + k·ln(n)`; the [`POLISHED`] leading ones get more iterations.
+
+use rayon::prelude::*;
+
+use super::augment::{Fitted, Problem};
+use super::candidates::Candidate;
+use super::refit::refit_candidate;
+use super::scan::starts_on_grid;
+
+/// Levenberg–Marquardt iterations of every candidate's refit (from each start)…
+pub const SCREEN_ITERATIONS: usize = 3;
+/// …and the further ones for the [`POLISHED`] leading candidates; the reference a gain is
+/// judged against gets both.
+pub const POLISH_ITERATIONS: usize = 6;
+pub const POLISHED: usize = 3;
+
+/// A candidate refitted and scored.
+#[derive(Clone, Debug)]
+pub struct Scored {
+    /// Index of the candidate in the round's list.
+    pub index: usize,
+    pub fitted: Fitted,
+    /// BIC of the reference minus the candidate's (positive: better).
+    pub bic_gain: f64,
+    /// The candidate's value (0 without a grid).
+    pub value: f64,
+}
+
+/// The reference of a round: `current` refitted with as many iterations as a polished
+/// candidate gets (`None` if it diverges).
+pub fn reference(prob: &Problem<'_>, current: &Fitted) -> Option<Fitted> {
+    prob.refit(&current.transforms, &current.terms, None, &current.theta, SCREEN_ITERATIONS + POLISH_ITERATIONS)
+        .map(|r| r.0)
+}
+
+/// Every candidate of `cands` not in `used`, refitted on top of `reference` and sorted by
+/// BIC gain, best first; `None` when the base model's Jacobian cannot be taken.
+pub fn rank(prob: &Problem<'_>, cands: &[Candidate], reference: &Fitted, used: &[usize]) -> Option<Vec<Scored>> {
+    let jac = prob.jacobian_at(&reference.theta, &reference.transforms)?;
+    let ntr = prob.train.len() as f64;
+    let bic = |f: &Fitted| ntr * f.train_mse.max(1e-300).ln() + (f.extra_params() as f64) * ntr.ln();
+    let bic_ref = bic(reference);
+    let mut scored: Vec<Scored> = cands
+        .par_iter()
+        .enumerate()
+        .filter(|(k, _)| !used.contains(k))
+        .filter_map(|(k, c)| {
+            let starts = starts_on_grid(prob, c, reference, &jac);
+            let (f, g) = refit_candidate(prob, c, reference, &starts, SCREEN_ITERATIONS)?;
+            let bic_gain = bic_ref - bic(&f);
+            Some(Scored { index: k, fitted: f, bic_gain, value: g })
+        })
+        .collect();
+    scored.sort_by(|a, b| b.bic_gain.total_cmp(&a.bic_gain));
+    // The leading candidates get the rest of the refit's iterations.
+    let polished: Vec<Scored> = scored
+        .par_iter()
+        .take(POLISHED)
+        .filter_map(|s| {
+            let (f, g) = (&s.fitted, s.value);
+            let base = Fitted { terms: f.terms[..reference.terms.len()].to_vec(), ..reference.clone() };
+            let base = Fitted { theta: f.theta.clone(), ..base };
+            let (f2, g2) = refit_candidate(prob, &cands[s.index], &base, &[(g, None)], POLISH_ITERATIONS)?;
+            let better = if f2.train_mse < f.train_mse { (f2, g2) } else { (f.clone(), g) };
+            Some(Scored { index: s.index, bic_gain: bic_ref - bic(&better.0), fitted: better.0, value: better.1 })
+        })
+        .collect();
+    for p in polished {
+        if let Some(slot) = scored.iter_mut().find(|s| s.index == p.index) {
+            *slot = p;
+        }
+    }
+    scored.sort_by(|a, b| b.bic_gain.total_cmp(&a.bic_gain));
+    Some(scored)
+}
