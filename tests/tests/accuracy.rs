@@ -2,7 +2,7 @@
 //! f64 adaptive-step reference for every ODE model and published parameter set, on the
 //! papers' excitations at 500 Hz and 3 kHz and on the real Dyke displacement.
 
-use hil_sim::models::accuracy::{self, MAX_R_RMSE};
+use hil_sim::sim::accuracy::{self, MAX_R_RMSE};
 
 #[test]
 fn every_ode_model_meets_the_bound() {

@@ -1,5 +1,5 @@
 use clap::Args;
-use hil_sim::models::accuracy::{self, Row, MAX_R_RMSE};
+use hil_sim::sim::accuracy::{self, Row, MAX_R_RMSE};
 use serde_json::json;
 
 #[derive(Args, Debug)]
@@ -17,29 +17,29 @@ pub struct AccuracyArgs {
     pub json: bool,
 }
 
-/// Run the check; returns the rows (also used by `demo`).
-pub fn rows(a: &AccuracyArgs) -> anyhow::Result<Vec<Row>> {
-    let rec = if a.no_recording {
+/// Run the check (only `model` when given, `quick` runs, with or without the Dyke
+/// recording); returns the rows (also used by `demo`).
+pub fn rows(model: Option<&str>, quick: bool, no_recording: bool) -> anyhow::Result<Vec<Row>> {
+    let rec = if no_recording {
         None
     } else {
         let path = hil_sim::io::bundled::data_file("dyke/ranran_50.csv").map_err(anyhow::Error::msg)?;
         Some(accuracy::load_dyke(&path).map_err(anyhow::Error::msg)?)
     };
-    if let Some(m) = &a.model {
+    if let Some(m) = model {
         if model_core::registry::find(m).is_none() {
             anyhow::bail!("unknown model `{m}` (see `hil-sim models`)");
         }
     }
-    let n = accuracy::count_jobs(a.model.as_deref(), a.quick, rec.is_some());
+    let n = accuracy::count_jobs(model, quick, rec.is_some());
     if n == 0 {
         anyhow::bail!(
             "no accuracy cases for {}: it has no ODE (stateless or exact operator models need none)",
-            a.model.as_deref().unwrap_or("any model")
+            model.unwrap_or("any model")
         );
     }
     let pb = super::progress(n as u64, "accuracy");
-    let rows =
-        accuracy::run_all(a.model.as_deref(), a.quick, rec.as_ref(), &|| pb.inc(1)).map_err(anyhow::Error::msg)?;
+    let rows = accuracy::run_all(model, quick, rec.as_ref(), &|| pb.inc(1)).map_err(anyhow::Error::msg)?;
     pb.finish_and_clear();
     Ok(rows)
 }
@@ -83,7 +83,7 @@ fn trunc(s: &str, n: usize) -> String {
 }
 
 pub fn run(a: AccuracyArgs) -> anyhow::Result<()> {
-    let rows = rows(&a)?;
+    let rows = rows(a.model.as_deref(), a.quick, a.no_recording)?;
     let fails = rows.iter().filter(|r| !r.pass).count();
     if a.json {
         let worst = rows.iter().map(|r| r.r_rmse).fold(0.0, f64::max);

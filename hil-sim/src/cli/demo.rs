@@ -4,12 +4,14 @@ use anyhow::Context;
 use clap::Args;
 use hil_sim::closed_loop::{compare as loop_compare, identify, multisine_reference, Run, T_START};
 use hil_sim::ident::dataset::{prepare, Dataset, Prepared};
+use hil_sim::ident::diagnose::Diagnosis;
 use hil_sim::ident::fit::{FitOptions, FitResult};
 use hil_sim::io::params_file::ParamsFile;
 use hil_sim::io::recording::Channels;
 use hil_sim::io::recording::Recording;
 use hil_sim::models::replay::replay_recording;
 use hil_sim::models::RateSpec;
+use hil_sim::numerics::metrics::Metrics;
 use hil_sim::report::fit::{error_bars, fit_plots, results_table, Labels};
 use hil_sim::report::plot::{self, Series, Style};
 use hil_sim::report::Report;
@@ -97,12 +99,8 @@ fn loop_plots(rep: &mut Report, dir: &Path, lp: &Run, bl: &Run) -> anyhow::Resul
     Ok(())
 }
 
-pub fn run(a: DemoArgs) -> anyhow::Result<()> {
-    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
-    let mut rep = Report::new("hil-sim demo: the MR clutch/damper toolchain on the bundled data");
-    let mut text = String::new();
-
-    // 1. Identification of every model on the real Dyke recordings.
+/// 1. Identification of every model on the real Dyke recordings.
+fn identification(rep: &mut Report, out: &Path, text: &mut String) -> anyhow::Result<Vec<DykeFit>> {
     let fits = vec![fit_dyke("dyke/ranran_50.csv")?, fit_dyke("dyke/ransim_u.csv")?];
     rep.heading("Identification on the real Dyke damper recordings");
     rep.paragraph(&format!(
@@ -116,27 +114,31 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         for w in &f.warnings {
             rep.paragraph(&format!("Quality warning: {w}"));
         }
-        results_table(&mut rep, &f.results);
+        results_table(rep, &f.results);
         let stem = f.file.trim_start_matches("dyke/").trim_end_matches(".csv").to_owned();
-        error_bars(&mut rep, &a.out, &stem, &f.results)?;
+        error_bars(rep, out, &stem, &f.results)?;
         if let Some(best) = f.results.iter().min_by(|x, y| x.heldout.rmse.total_cmp(&y.heldout.rmse)) {
             rep.paragraph(&format!(
                 "Best held-out: **{}**, RMSE {:.1} N, R² {:.4}, fitted in {:.2} s.",
                 best.model, best.heldout.rmse, best.heldout.r2, best.fit_seconds
             ));
             let labels = Labels { input: "D (cm)".into(), output: "F (N)".into() };
-            fit_plots(&mut rep, &a.out, &format!("{stem}_{}", best.model), &f.data, best, &labels)?;
+            fit_plots(rep, out, &format!("{stem}_{}", best.model), &f.data, best, &labels)?;
         }
-        text += &format!("\n{} (fit on the first {:.0} %, scored on the rest)\n", f.file, 100.0 * TRAIN);
-        text += &super::fit::table(&f.results);
+        *text += &format!("\n{} (fit on the first {:.0} %, scored on the rest)\n", f.file, 100.0 * TRAIN);
+        *text += &super::fit::table(&f.results);
     }
 
-    // 2. The published Spencer set, replayed.
+    Ok(fits)
+}
+
+/// 2. The published Spencer set, replayed: the report's table and the JSON rows.
+fn published_spencer(rep: &mut Report, fits: &[DykeFit]) -> anyhow::Result<Vec<serde_json::Value>> {
     let pf: ParamsFile = serde_json::from_str(SPENCER).context("bundled Spencer parameter file")?;
     let flat = pf.flat(Path::new("hil-sim/params/spencer_dyke_1997.json"))?;
     let mut rows = Vec::new();
     let mut replays = Vec::new();
-    for f in &fits {
+    for f in fits {
         let r = replay_recording(&f.rec, &dyke_channels(), &pf.model, &flat, RateSpec::Backward, (0.0, 0.0))?;
         let m = r.metrics;
         rows.push(vec![
@@ -151,7 +153,11 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     rep.heading("Spencer et al. 1997's published set, replayed (whole recordings)");
     rep.table(&["recording", "samples", "RMSE (N)", "R²", "R-RMSE"], &rows);
 
-    // 3. The closed loop on the simulated clutch.
+    Ok(replays)
+}
+
+/// 3. The closed loop on the simulated clutch: tracking of the loop and of the baseline.
+fn closed_loop(rep: &mut Report, out: &Path, text: &mut String) -> anyhow::Result<(Metrics, Metrics)> {
     eprintln!("closed loop on the simulated clutch (multi-sine reference)");
     let clutch = ClutchParams::default();
     let id = identify(&clutch, 10_000.0, 1).context("identifying the simulated clutch")?;
@@ -165,14 +171,18 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         100.0 * tb.r_rmse,
         tb.r_rmse / tl.r_rmse.max(1e-12)
     ));
-    loop_plots(&mut rep, &a.out, &lp, &bl)?;
-    text += &format!(
+    loop_plots(rep, out, &lp, &bl)?;
+    *text += &format!(
         "\nclosed loop, multi-sine: tracking R-RMSE {:.2} % vs open-loop baseline {:.2} %\n",
         100.0 * tl.r_rmse,
         100.0 * tb.r_rmse
     );
 
-    // 4. A diagnosis: the damper file through a model that ignores the command voltage.
+    Ok((tl, tb))
+}
+
+/// 4. A diagnosis: the damper file through a model that ignores the command voltage.
+fn diagnosis(rep: &mut Report, out: &Path, text: &mut String) -> anyhow::Result<Diagnosis> {
     eprintln!("diagnosing ranran_50.csv from bouc_wen without the command channel");
     let diag_rec = hil_sim::io::bundled::data_file("dyke/ranran_50.csv").map_err(anyhow::Error::msg)?;
     let diag_ch =
@@ -190,16 +200,15 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         "The classical Bouc–Wen model has no command input, so it cannot know that the damper's force follows the \
          command voltage Y. `diagnose` is given D and F only; Y and A are auxiliary channels it may use.",
     );
-    hil_sim::ident::diagnose::report::section(&mut rep, &a.out, "diagnose_ranran50", &diag, ("D", "F"))?;
-    text += &format!("\ndiagnosis of ranran_50.csv from bouc_wen (no --command):\n{}", super::diagnose::text(&diag));
+    hil_sim::report::diagnose::section(rep, out, "diagnose_ranran50", &diag, ("D", "F"))?;
+    *text += &format!("\ndiagnosis of ranran_50.csv from bouc_wen (no --command):\n{}", super::diagnose::text(&diag));
 
-    // 5. The fixed-step core against f64 references (short runs).
-    let acc = super::accuracy::rows(&super::accuracy::AccuracyArgs {
-        model: None,
-        quick: true,
-        no_recording: false,
-        json: false,
-    })?;
+    Ok(diag)
+}
+
+/// 5. The fixed-step core against f64 references (short runs), and the models' table.
+fn accuracy(rep: &mut Report) -> anyhow::Result<(usize, f64)> {
+    let acc = super::accuracy::rows(None, true, false)?;
     let worst = acc.iter().map(|r| r.r_rmse).fold(0.0, f64::max);
     rep.heading("Fixed-step f32 core vs f64 adaptive references");
     rep.paragraph(&format!(
@@ -209,6 +218,18 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     ));
     rep.heading("Models (model-core, no_std, f32, fixed step)");
     rep.paragraph(&format!("```\n{}```", super::models::table()));
+    Ok((acc.len(), worst))
+}
+
+pub fn run(a: DemoArgs) -> anyhow::Result<()> {
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let mut rep = Report::new("hil-sim demo: the MR clutch/damper toolchain on the bundled data");
+    let mut text = String::new();
+    let fits = identification(&mut rep, &a.out, &mut text)?;
+    let replays = published_spencer(&mut rep, &fits)?;
+    let (tl, tb) = closed_loop(&mut rep, &a.out, &mut text)?;
+    let diag = diagnosis(&mut rep, &a.out, &mut text)?;
+    let (acc_runs, worst) = accuracy(&mut rep)?;
     let index = rep.write(&a.out).with_context(|| format!("writing the report to {}", a.out.display()))?;
 
     if a.json {
@@ -219,7 +240,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
             "published_spencer": replays,
             "loop": {"tracking": tl, "baseline": tb},
             "diagnosis": diag,
-            "accuracy": {"runs": acc.len(), "worst_r_rmse": worst},
+            "accuracy": {"runs": acc_runs, "worst_r_rmse": worst},
             "report": index,
         }));
     }

@@ -89,7 +89,7 @@ pub fn run(a: DiagnoseArgs) -> anyhow::Result<()> {
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         let mut rep = hil_sim::report::Report::new(format!("Diagnosis of {}", a.rec.display()));
-        hil_sim::ident::diagnose::report::section(&mut rep, dir, "diagnose", &d, (&a.ch.input, &a.ch.output))?;
+        hil_sim::report::diagnose::section(&mut rep, dir, "diagnose", &d, (&a.ch.input, &a.ch.output))?;
         let index = rep.write(dir)?;
         eprintln!("report written to {}", index.display());
     }

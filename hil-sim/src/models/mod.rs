@@ -2,7 +2,6 @@
 //! registry ([`visit`]): running it over samples ([`replay()`]), its search box and start
 //! values for identification, its f64 reference, the accuracy check of the f32 core.
 
-pub mod accuracy;
 pub mod alignment;
 pub mod reference;
 pub mod replay;

@@ -13,6 +13,7 @@
 //! r.write("target/report").unwrap();
 //! ```
 
+pub mod diagnose;
 pub mod fit;
 pub mod fit_page;
 pub mod plot;

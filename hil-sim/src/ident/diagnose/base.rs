@@ -3,6 +3,8 @@
 //! something to absorb silently). `auto` fits every seed model ([`AUTO_BASES`]) and keeps
 //! the one with the lowest held-out RMSE.
 
+use model_core::{models, Model};
+
 use super::options::{DiagnoseError, DiagnoseOptions};
 use crate::ident::fit::simulate::Simulator;
 use crate::ident::fit::{fit, Dataset, DelayChoice, FitOptions, FitResult};
@@ -11,8 +13,18 @@ use crate::progress::Progress;
 
 /// The seed models `auto` (no base model given) chooses among: every parametric model of the papers
 /// (the operator and data-driven models describe a loop without naming physics).
-pub const AUTO_BASES: &[&str] =
-    &["algebraic", "bouc_wen", "lugre", "tanh", "dahl", "spencer", "bingham", "arctan", "arctan_inertia", "trig"];
+pub const AUTO_BASES: &[&str] = &[
+    models::algebraic::Registered::ID,
+    models::bouc_wen::Registered::ID,
+    models::lugre::Registered::ID,
+    models::tanh::Registered::ID,
+    models::dahl::Registered::ID,
+    models::spencer::Registered::ID,
+    models::bingham::Registered::ID,
+    models::arctan::Registered::ID,
+    models::arctan_inertia::Registered::ID,
+    models::trig::Registered::ID,
+];
 
 /// Levenberg–Marquardt iterations of the base model's fit.
 const LM_ITERATIONS: usize = 30;

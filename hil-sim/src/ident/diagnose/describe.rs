@@ -39,21 +39,7 @@ pub struct Described<'a> {
     pub rows: &'a [usize],
 }
 
-/// Units of well-known channel names (the clutch contract's and the Dyke files').
-pub fn unit_of(name: &str) -> Option<&'static str> {
-    Some(match name {
-        "b" | "B" => "T",
-        "torque" | "T" | "torque_true" => "N·m",
-        "F" => "N",
-        "D" => "cm",
-        "V" => "cm/s",
-        "Y" => "V",
-        "i" | "i_ref" => "A",
-        "speed" => "rad/s",
-        "temperature" => "°C",
-        _ => return None,
-    })
-}
+pub use crate::numerics::units::unit_of;
 
 /// A finding's text, values, windows and conditions.
 pub fn finding(d: &Described<'_>) -> Finding {

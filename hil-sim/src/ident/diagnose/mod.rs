@@ -20,9 +20,9 @@
 //!    the paired block test ([`significance`]) is kept, and the search repeats on what
 //!    remains (at most `max_findings` rounds). A recording with nothing missing ends with
 //!    no finding.
-//! 5. **Report** ([`describe`], [`report`]). Each finding says which physics, how big (its
+//! 5. **Report** ([`describe`], [`crate::report::diagnose`]). Each finding says which physics, how big (its
 //!    fitted values with units and the RMS of what it adds), where (windows and conditions
-//!    where the gain concentrates) and the held-out error before and after; [`report`]
+//!    where the gain concentrates) and the held-out error before and after; [`crate::report::diagnose`]
 //!    draws the plots.
 
 pub mod accept;
@@ -36,7 +36,6 @@ pub mod options;
 pub mod profile;
 pub mod rank;
 pub mod refit;
-pub mod report;
 pub mod scan;
 pub mod significance;
 

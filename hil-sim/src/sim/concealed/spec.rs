@@ -2,6 +2,7 @@
 //! excitation, size, length) and why it can refuse ([`ConcealedError`]). The errors carry
 //! the values; the CLI names its flags when it prints them.
 
+use model_core::{models, Model};
 use thiserror::Error;
 
 /// Every effect `generate` can conceal (`none`: a null recording).
@@ -19,7 +20,13 @@ pub const EFFECTS: &[&str] = &[
     "sensor_offset",
 ];
 /// Base models of the truth.
-pub const BASES: &[&str] = &["algebraic", "bouc_wen", "lugre", "tanh", "dahl"];
+pub const BASES: &[&str] = &[
+    models::algebraic::Registered::ID,
+    models::bouc_wen::Registered::ID,
+    models::lugre::Registered::ID,
+    models::tanh::Registered::ID,
+    models::dahl::Registered::ID,
+];
 /// Field excitations.
 pub const EXCITATIONS: &[&str] = &["multisine", "noise", "sweep", "triangle", "bipolar"];
 /// Largest effect size, fraction of the torque span.

@@ -4,9 +4,9 @@
 
 use std::path::Path;
 
-use super::describe::unit_of;
-use super::diagnosis::Diagnosis;
-use super::locate;
+use crate::ident::diagnose::diagnosis::Diagnosis;
+use crate::ident::diagnose::locate;
+use crate::numerics::units::unit_of;
 use crate::report::plot::{self, PlotError};
 use crate::report::Report;
 
