@@ -20,8 +20,8 @@
 
 use std::path::Path;
 
+use hil_sim::ident::dataset::prepare_recording;
 use hil_sim::ident::diagnose::{diagnose, DiagnoseOptions};
-use hil_sim::ident::fit::Dataset;
 use hil_sim::io::recording::Channels;
 use hil_sim::progress::NoProgress;
 use hil_sim::sim::concealed::{generate, ConcealedSpec};
@@ -59,15 +59,14 @@ fn run(effect: &str, base: &str, excitation: &str, seed: u64) -> Outcome {
         ..ConcealedSpec::default()
     };
     let g = generate(&spec).unwrap_or_else(|e| panic!("{effect}/{base}/{excitation}: {e}"));
-    let rec = &g.recording;
     let ch = Channels::default();
     // As `hil-sim diagnose` does: samples the quality check flags (a clipped torque, a
     // standstill) are left out of the fit and the scores.
-    let excluded = hil_sim::quality::check(rec, &ch).expect("quality check").excluded();
-    let data = Dataset::new(rec, &ch, 0.7, Some(excluded)).expect("dataset");
+    let prepared = prepare_recording(g.recording, &ch, 0.7, false).expect("dataset");
+    let (rec, data) = (&prepared.recording, &prepared.data);
     let aux = rec.auxiliary_channels(&ch);
     let opts = DiagnoseOptions { model: Some(base.into()), ..DiagnoseOptions::default() };
-    let d = diagnose(&data, aux, None, ("b", "torque"), &opts, &NoProgress)
+    let d = diagnose(data, aux, None, ("b", "torque"), &opts, &NoProgress)
         .unwrap_or_else(|e| panic!("{effect}/{base}/{excitation}: {e}"));
     let top = d.findings.first();
     Outcome {

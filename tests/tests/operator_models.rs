@@ -11,7 +11,6 @@ use std::sync::OnceLock;
 
 use hil_sim::ident::fit::{fit, Dataset, FitOptions, FitResult};
 use hil_sim::io::recording::Channels;
-use hil_sim::quality;
 use hil_sim::sim::scenario::Scenario;
 use model_core::models::prandtl_ishlinskii::PrandtlIshlinskii;
 use model_core::{Kin, Model};
@@ -25,8 +24,7 @@ fn dataset(name: &str, duration: Option<f64>, ch: &Channels, train: f64) -> Data
     }
     let rec = hil_sim::closed_loop::record::record(&sc).expect("simulation");
     let recording = rec.recording;
-    let q = quality::check(&recording, ch).expect("quality checks");
-    Dataset::new(&recording, ch, train, Some(q.excluded())).expect("dataset")
+    hil_sim::ident::dataset::prepare_recording(recording, ch, train, false).expect("dataset").data
 }
 
 fn channels(input: &str, command: Option<&str>) -> Channels {

@@ -2,11 +2,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
+use hil_sim::ident::dataset::{prepare, Dataset, Prepared};
 use hil_sim::ident::diagnose::{diagnose, DiagnoseError, DiagnoseOptions, Diagnosis};
-use hil_sim::ident::fit::Dataset;
 use hil_sim::io::recording::Channels;
-use hil_sim::io::recording::Recording;
-use hil_sim::quality;
 
 use super::progress::Bar;
 use super::ChannelArgs;
@@ -54,13 +52,10 @@ pub fn run_diagnosis(
 ) -> anyhow::Result<(Diagnosis, Dataset)> {
     opts.check().map_err(flagged)?;
     let path = super::file_arg(rec)?;
-    let rec = Recording::read(&path)?;
-    let q = quality::check(&rec, ch)?;
+    let Prepared { recording: rec, quality: q, data } = prepare(&path, ch, 1.0 - opts.heldout, keep_flagged)?;
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
     }
-    let excluded = (!keep_flagged).then(|| q.excluded());
-    let data = Dataset::new(&rec, ch, 1.0 - opts.heldout, excluded).with_context(|| format!("{}", path.display()))?;
     let aux = rec.auxiliary_channels(ch);
     let bar = Bar::new(1, "diagnosing");
     let d = diagnose(&data, aux, ch.command.as_deref(), (&ch.input, &ch.output), opts, &bar);

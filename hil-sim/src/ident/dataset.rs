@@ -143,10 +143,19 @@ pub struct Prepared {
 /// Read `path`, run the data-quality checks on the channels `ch` and split at `train`;
 /// flagged samples are left out of fitting unless `keep_flagged`.
 pub fn prepare(path: &Path, ch: &Channels, train: f64, keep_flagged: bool) -> Result<Prepared, DatasetError> {
-    let recording = Recording::read(path)?;
+    prepare_recording(Recording::read(path)?, ch, train, keep_flagged)
+}
+
+/// [`prepare`] for a recording already in memory (a generated one, or a file read before).
+pub fn prepare_recording(
+    recording: Recording,
+    ch: &Channels,
+    train: f64,
+    keep_flagged: bool,
+) -> Result<Prepared, DatasetError> {
     let quality = quality::check(&recording, ch)?;
     let excluded = (!keep_flagged).then(|| quality.excluded());
     let data = Dataset::new(&recording, ch, train, excluded)
-        .map_err(|e| DatasetError::In { path: path.to_owned(), source: Box::new(e) })?;
+        .map_err(|e| DatasetError::In { path: recording.path.clone(), source: Box::new(e) })?;
     Ok(Prepared { recording, quality, data })
 }

@@ -3,11 +3,11 @@
 
 use model_core::models::arctan::Registered;
 
-use super::search::{ParamSpec, Scales, Spreads, Strategy};
+use super::search::{ParamSpec, Scales, SearchBox, Spreads, Strategy};
 use super::HostModel;
 
 impl HostModel for Registered {
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(s: &Scales) -> Option<SearchBox> {
         Some((search_box(s), Strategy::Global))
     }
 }

@@ -3,11 +3,11 @@
 
 use model_core::models::arctan_inertia::Registered;
 
-use super::search::{ParamSpec, Scales, Spreads, Strategy};
+use super::search::{ParamSpec, Scales, SearchBox, Spreads, Strategy};
 use super::HostModel;
 
 impl HostModel for Registered {
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { y, a, .. } = Spreads::of(s);
         let mut ps = super::arctan::search_box(s);
         ps.push(ParamSpec::new("m", -10.0 * y / a, 10.0 * y / a, 0.0));

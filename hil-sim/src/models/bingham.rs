@@ -4,11 +4,11 @@
 use model_core::models::bingham::Registered;
 use model_core::Kin;
 
-use super::search::{ParamSpec, Scales, Spreads, Strategy};
+use super::search::{ParamSpec, Scales, SearchBox, Spreads, Strategy};
 use super::{HostModel, MAX_REGRESSORS};
 
 impl HostModel for Registered {
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { v, y, ym, no_u, u, big_y, .. } = Spreads::of(s);
         let p = ParamSpec::new;
         Some((

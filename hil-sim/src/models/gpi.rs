@@ -3,7 +3,7 @@
 
 use model_core::models::gpi::Registered;
 
-use super::search::{ModelSpec, ParamSpec, Scales, Spreads, Strategy, Structure};
+use super::search::{ModelSpec, ParamSpec, Scales, SearchBox, Spreads, Strategy, Structure};
 use super::HostModel;
 
 impl HostModel for Registered {
@@ -16,7 +16,7 @@ impl HostModel for Registered {
     /// [0, 35]) are written for the raw input: b moves the bend of tanh over the range,
     /// a and c scale with the span. p₀, δ₁ and the common envelope offset (c_r) are
     /// solved in closed form; c_l is the left envelope's offset relative to the right.
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { x, .. } = Spreads::of(s);
         let p = ParamSpec::new;
         let span = 4.0 * x;

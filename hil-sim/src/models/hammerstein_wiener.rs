@@ -4,7 +4,7 @@
 use model_core::models::hammerstein_wiener::Registered;
 use model_core::Model;
 
-use super::search::{network_layout, ParamSpec, Scales, Strategy, Structure};
+use super::search::{network_layout, Scales, SearchBox, Strategy, Structure};
 use super::HostModel;
 
 impl HostModel for Registered {
@@ -12,7 +12,7 @@ impl HostModel for Registered {
 
     /// Trained by [`crate::ident::fit`]'s network trainer, which sets every value from the
     /// data; the box here only documents the layout.
-    fn search(_s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(_s: &Scales) -> Option<SearchBox> {
         Some((network_layout(Self::PARAM_NAMES, Self::N_PARAMS), Strategy::Network))
     }
 }

@@ -4,7 +4,7 @@
 use model_core::models::maxwell_slip::Registered;
 use model_core::Model;
 
-use super::search::{ParamSpec, Scales, Spreads, Strategy, Structure};
+use super::search::{ParamSpec, Scales, SearchBox, Spreads, Strategy, Structure};
 use super::HostModel;
 
 impl HostModel for Registered {
@@ -12,7 +12,7 @@ impl HostModel for Registered {
 
     /// Seed 004 eq. 23–25 (Table A15: kᵢ ∈ [0.01, 10], fᵢ ∈ [0, 10] normalised): the
     /// breakaway deflections fᵢ/kᵢ spread over the range, stiffnesses by the closed form.
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { x, y, ym, big_y, .. } = Spreads::of(s);
         let p = ParamSpec::new;
         let n = (Self::N_PARAMS - 2) / 2;

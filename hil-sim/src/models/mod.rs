@@ -28,7 +28,7 @@ mod trig;
 pub use model_core::registry::{visit, Visit};
 
 use model_core::{Kin, Model};
-use search::{ModelSpec, ParamSpec, Scales, Strategy, Structure};
+use search::{ModelSpec, Scales, SearchBox, Structure};
 
 /// Most regressors a model linear in its parameters has.
 pub const MAX_REGRESSORS: usize = 10;
@@ -40,7 +40,7 @@ pub trait HostModel: Model {
     /// The search box, start values and fitting method for data with these spreads: the
     /// papers' boxes written in the recording's own scales. `None` when the box cannot be
     /// built.
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)>;
+    fn search(s: &Scales) -> Option<SearchBox>;
 
     /// The model-specific structure the fitting method exploits.
     const STRUCTURE: Structure = Structure::Generic;
@@ -69,7 +69,7 @@ pub trait HostModel: Model {
 pub struct Host {
     pub id: &'static str,
     pub structure: Structure,
-    search: fn(&Scales) -> Option<(Vec<ParamSpec>, Strategy)>,
+    search: fn(&Scales) -> Option<SearchBox>,
     variant: fn(&ModelSpec, usize, &Scales) -> Option<ModelSpec>,
     regressors: fn(&Kin, &mut [f64; MAX_REGRESSORS]) -> Option<usize>,
     reference_cases: fn() -> Vec<reference::Case>,

@@ -4,7 +4,7 @@
 use model_core::models::prandtl_ishlinskii::Registered;
 use model_core::Model;
 
-use super::search::{ParamSpec, Scales, Spreads, Strategy, Structure};
+use super::search::{ParamSpec, Scales, SearchBox, Spreads, Strategy, Structure};
 use super::HostModel;
 
 impl HostModel for Registered {
@@ -12,7 +12,7 @@ impl HostModel for Registered {
 
     /// Seed 004 eq. 10–15: radii and weights set by the closed form (bounds as Table A7
     /// in the recording's units: radii up to the span, weights ≥ 0).
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { x, y, big_y, .. } = Spreads::of(s);
         let p = ParamSpec::new;
         let n = (Self::N_PARAMS - 2) / 2;

@@ -3,7 +3,7 @@
 
 use model_core::models::preisach::Registered;
 
-use super::search::{ModelSpec, ParamSpec, Scales, Spreads, Strategy, Structure};
+use super::search::{ModelSpec, ParamSpec, Scales, SearchBox, Spreads, Strategy, Structure};
 use super::HostModel;
 
 impl HostModel for Registered {
@@ -12,7 +12,7 @@ impl HostModel for Registered {
     /// Seed 004 eq. 5–9 (Table A1: σ_HM ∈ [0, 10], μ_HM ∈ [0, 20], σ_HC ∈ [0, 1],
     /// μ_HC ∈ [0, 0.1] on the normalised input). The grid spans the training range, set
     /// from the data by the fit; y₀ and the scale are solved in closed form.
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { x, y, ym, .. } = Spreads::of(s);
         let p = ParamSpec::new;
         Some((

@@ -194,6 +194,9 @@ impl Spreads {
     }
 }
 
+/// A model's search box and the method that fits it, as its host file writes them.
+pub type SearchBox = (Vec<ParamSpec>, Strategy);
+
 /// Everything the fit needs to know about one model.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ModelSpec {

@@ -3,11 +3,11 @@
 
 use model_core::models::tanh::Registered;
 
-use super::search::{ParamSpec, Scales, Spreads, Strategy};
+use super::search::{ParamSpec, Scales, SearchBox, Spreads, Strategy};
 use super::HostModel;
 
 impl HostModel for Registered {
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { x, v, y, ym, big_y, .. } = Spreads::of(s);
         let p = ParamSpec::new;
         Some((

@@ -3,11 +3,11 @@
 
 use model_core::models::trig::Registered;
 
-use super::search::{ParamSpec, Scales, Spreads, Strategy};
+use super::search::{ParamSpec, Scales, SearchBox, Spreads, Strategy};
 use super::HostModel;
 
 impl HostModel for Registered {
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { v, y, ym, no_u, u, big_y, .. } = Spreads::of(s);
         let p = ParamSpec::new;
         // Seven quadratic polynomials in the command (seed 002 eq. 31–37): [P0, P1, P2].

@@ -6,7 +6,7 @@ pub(crate) mod reference;
 use model_core::models::bouc_wen_asym::Registered;
 
 use super::reference::Case;
-use super::search::{ModelSpec, ParamSpec, Scales, Spreads, Strategy, Structure};
+use super::search::{ModelSpec, ParamSpec, Scales, SearchBox, Spreads, Strategy, Structure};
 use super::HostModel;
 
 impl HostModel for Registered {
@@ -16,7 +16,7 @@ impl HostModel for Registered {
     /// β, γ ∈ [−50, 50], z(0) ∈ [0, 0.2], δ ∈ [0, 5], p ∈ [0, 2], q ∈ [0, 1]) written
     /// for the raw input; n = 2 (closed-form step, as for `bouc_wen`). Eq. 31 first, eq.
     /// 30 as the variant ([`variant`]).
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { x, v, y, .. } = Spreads::of(s);
         let p = ParamSpec::new;
         let span = 4.0 * x;

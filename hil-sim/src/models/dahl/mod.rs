@@ -6,11 +6,11 @@ pub(crate) mod reference;
 use model_core::models::dahl::Registered;
 
 use super::reference::Case;
-use super::search::{ParamSpec, Scales, Spreads, Strategy};
+use super::search::{ParamSpec, Scales, SearchBox, Spreads, Strategy};
 use super::HostModel;
 
 impl HostModel for Registered {
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { x, v, y, ym, no_u, u, big_y, .. } = Spreads::of(s);
         let p = ParamSpec::new;
         Some((

@@ -6,7 +6,7 @@ pub(crate) mod reference;
 use model_core::models::spencer::{Registered, DYKE_1997_FLAT};
 
 use super::reference::Case;
-use super::search::{published, ParamSpec, Scales, Spreads, Strategy};
+use super::search::{published, ParamSpec, Scales, SearchBox, Spreads, Strategy};
 use super::HostModel;
 
 /// Spencer et al. (1997) for the Dyke damper (x in cm, F in N, v in V), in flat order:
@@ -18,7 +18,7 @@ pub(crate) fn dyke_1997() -> [f64; 14] {
 pub(crate) const DYKE_SCALES: (f64, f64, f64) = (0.35, 16.0, 430.0);
 
 impl HostModel for Registered {
-    fn search(s: &Scales) -> Option<(Vec<ParamSpec>, Strategy)> {
+    fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { x, v, y, no_u, u, .. } = Spreads::of(s);
         let p = ParamSpec::new;
         let (dx0, dv0, dy0) = DYKE_SCALES;
