@@ -1,9 +1,9 @@
 //! Firmware of the MR clutch torque controller on the STM32G474RE.
 //!
-//! Built for `thumbv7em-none-eabihf` this is the embassy application in [`app`]: the
-//! board's pins and analog scales ([`board`]), the 20 kHz control interrupt that runs
-//! `model_core::control::ControlStep` verbatim ([`controller`]), and the safe state on
-//! panics and faults ([`safety`]). Built for the host (as part of
+//! Built for `thumbv7em-none-eabihf` this is the embassy application in `app`: the
+//! board's pins and analog scales (`board`), the 20 kHz control interrupt that runs
+//! `model_core::control::ControlStep` verbatim (`controller`), and the safe state on
+//! panics and faults (`safety`). Built for the host (as part of
 //! `cargo build/test/clippy --workspace`) it is a stub `main` that only says so; all
 //! embedded dependencies are target-gated in Cargo.toml, and every piece of logic the
 //! firmware needs (control step, configuration page, command protocol) lives in model-core,

@@ -1,7 +1,7 @@
 //! The list of every model: identifier, parameter names, `no_std` and state size.
 //! `hil-sim models --json` prints exactly this.
 //!
-//! The model types are listed once, in [`for_each_model!`]; everything that needs the
+//! The model types are listed once, in [`for_each_model!`](crate::for_each_model); everything that needs the
 //! list (this table, [`visit`], the host's per-model registry in `hil-sim`) is built from
 //! it, so an 18th model is one line here plus its module.
 

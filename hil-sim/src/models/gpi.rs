@@ -12,7 +12,7 @@ impl HostModel for Registered {
     /// Seed 004 eq. 16–22 with hyperbolic-tangent envelopes (its best, Table A9: GOF
     /// 0.974): `α(x) = a·tanh(x + b) + c`. A saturating MR loop is concave, which the
     /// polynomial envelope (curvature fixed at +1) cannot follow; it is tried as the
-    /// variant ([`variant`]). The paper's normalised bounds (a, b, c ∈ [−5, 5], δ₂ ∈
+    /// variant ([`HostModel::variant`]). The paper's normalised bounds (a, b, c ∈ [−5, 5], δ₂ ∈
     /// [0, 35]) are written for the raw input: b moves the bend of tanh over the range,
     /// a and c scale with the span. p₀, δ₁ and the common envelope offset (c_r) are
     /// solved in closed form; c_l is the left envelope's offset relative to the right.

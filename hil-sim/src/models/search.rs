@@ -129,12 +129,12 @@ pub enum Strategy {
     /// Particle swarm over the box, then Levenberg–Marquardt from the best candidates.
     Global,
     /// Operator model linear in its weights for fixed radii: sign-constrained least squares
-    /// for a few radius spreads ([`super::operator::closed_form`]).
+    /// for a few radius spreads ([`crate::ident::fit::operator::closed_form`]).
     Operator,
     /// Particle swarm and Levenberg–Marquardt over the shape only, the output scale and
-    /// offset solved in closed form at every evaluation ([`super::operator::Projected`]).
+    /// offset solved in closed form at every evaluation ([`crate::ident::fit::operator::Projected`]).
     Projected,
-    /// Network trained in simulation mode by Levenberg–Marquardt ([`super::narx`]).
+    /// Network trained in simulation mode by Levenberg–Marquardt ([`crate::ident::fit::narx`]).
     Network,
 }
 

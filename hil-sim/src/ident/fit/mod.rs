@@ -3,16 +3,17 @@
 //!
 //! - [`Dataset`]: one recording's input, output and command, the time-ordered train /
 //!   held-out split and the samples the quality checks flagged.
-//! - [`spec`]: per model, the search box and starting values (from the papers, rescaled to
-//!   the recording's units) and the method.
+//! - Each model's search box, starting values (from the papers, rescaled to the
+//!   recording's units) and method are in its host file ([`crate::models::HostModel`]).
 //! - Methods: closed-form least squares ([`linear`]) where the model is linear in its
 //!   parameters; for the models with local minima, a small particle swarm ([`global`])
 //!   on a window of the training part, bounded Levenberg–Marquardt ([`lm`]) polishing its
 //!   best points and the papers' starting values on that window, and a final
 //!   Levenberg–Marquardt run on the whole training part from the candidate that scores best
 //!   there.
+//! - [`job`] runs `hil-sim fit` as one call (read, check, fit with progress, save).
 //! - [`fit`] returns the parameters and all metrics of the contract, train and held-out,
-//!   from a replay through [`crate::models::replay`] — the `Estimator` path, f32.
+//!   from a replay through [`crate::models::replay()`] — the `Estimator` path, f32.
 
 pub mod global;
 pub mod job;

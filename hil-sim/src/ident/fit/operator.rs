@@ -2,7 +2,7 @@
 //!
 //! - Prandtl–Ishlinskii and Maxwell-slip are linear in their weights once the radii
 //!   (breakaway deflections) are fixed: the weights come from one sign-constrained least
-//!   squares ([`super::nnls`], seed 004's bounds `p₀, pᵢ, kᵢ ≥ 0`), for a few radius
+//!   squares ([`crate::numerics::nnls`], seed 004's bounds `p₀, pᵢ, kᵢ ≥ 0`), for a few radius
 //!   spreads; the best on the training rows wins ([`closed_form`]).
 //! - Preisach and GPI are linear in their output scale and offset (`y₀, s`; `p₀, δ₁` and
 //!   an envelope shift) but not in the density or envelope shape. [`Projected`] wraps the

@@ -15,7 +15,7 @@ impl HostModel for Registered {
     /// Seed 004 eq. 26–31, Tables A17–A18 (normalised: D ∈ (0, 5], A ∈ [−5, 5],
     /// β, γ ∈ [−50, 50], z(0) ∈ [0, 0.2], δ ∈ [0, 5], p ∈ [0, 2], q ∈ [0, 1]) written
     /// for the raw input; n = 2 (closed-form step, as for `bouc_wen`). Eq. 31 first, eq.
-    /// 30 as the variant ([`variant`]).
+    /// 30 as the variant ([`HostModel::variant`]).
     fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { x, v, y, .. } = Spreads::of(s);
         let p = ParamSpec::new;

@@ -22,7 +22,7 @@
 //!    clutch: the fluid warming up under its own slip power, its yield stress falling).
 //!    Written into eq. 18–19 exactly: `ŷ(t) = G(t) + a·ŷ(t−1) − (a − κ)·G(t−1) + d`, the
 //!    other half of the units being `G`'s units on the inputs one sample later
-//!    (`û(t−1) … û(t−5)`). For each time constant of [`SLOW_GRID`], `κ` and `d` are linear
+//!    (`û(t−1) … û(t−5)`). For each time constant of `SLOW_GRID`, `κ` and `d` are linear
 //!    least squares; the best fit is the start.
 //! 3. **Simulation mode.** Every weight is then trained by LM on the fit block (the first
 //!    part of the training data), the model running on its own output.
