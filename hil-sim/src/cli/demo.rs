@@ -188,7 +188,7 @@ fn diagnosis(rep: &mut Report, out: &Path, text: &mut String) -> anyhow::Result<
     let diag_ch =
         hil_sim::io::recording::Channels { time: "t".into(), input: "D".into(), output: "F".into(), command: None };
     let diag_opts = hil_sim::ident::diagnose::DiagnoseOptions {
-        model: Some("bouc_wen".into()),
+        model: Some(<model_core::models::bouc_wen::Registered as model_core::Model>::ID.into()),
         heldout: 0.3,
         rate: None,
         seed: 1,

@@ -69,7 +69,7 @@ impl Reference for BoucWenRef {
 
 fn case(label: &str, params: Vec<f32>, scale: InputScale) -> Case {
     Case {
-        model: "bouc_wen",
+        model: <model_core::models::bouc_wen::Registered as model_core::Model>::ID,
         label: label.to_string(),
         reference: Box::new(BoucWenRef::from_params(&params)),
         params,

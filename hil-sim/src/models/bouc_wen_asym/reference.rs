@@ -122,7 +122,7 @@ pub fn cases() -> Vec<Case> {
         .filter_map(|(label, params)| {
             let reference = BoucWenAsymRef::from_params(params)?;
             Some(Case {
-                model: "bouc_wen_asym",
+                model: <model_core::models::bouc_wen_asym::Registered as model_core::Model>::ID,
                 label: (*label).to_string(),
                 params: params.to_vec(),
                 reference: Box::new(reference),

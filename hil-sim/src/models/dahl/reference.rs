@@ -90,7 +90,7 @@ pub fn cases() -> Vec<Case> {
         .iter()
         .enumerate()
         .map(|(i, &volt)| Case {
-            model: "dahl",
+            model: <model_core::models::dahl::Registered as model_core::Model>::ID,
             label: format!(
                 "plausible Dyke-damper set (not published; see hil-sim reference/dahl.rs), x in cm, F in N, {volt} V"
             ),

@@ -72,7 +72,7 @@ pub fn cases() -> Vec<Case> {
     table4
         .iter()
         .map(|(f, p)| Case {
-            model: "lugre",
+            model: <model_core::models::lugre::Registered as model_core::Model>::ID,
             label: format!("seed 000 Table 4 {f}"),
             params: p.to_vec(),
             reference: Box::new(LuGreRef::from_params(p)),

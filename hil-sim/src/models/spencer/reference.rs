@@ -118,7 +118,7 @@ pub fn cases() -> Vec<Case> {
         .iter()
         .enumerate()
         .map(|(i, &volt)| Case {
-            model: "spencer",
+            model: <model_core::models::spencer::Registered as model_core::Model>::ID,
             label: format!("Spencer et al. 1997, Dyke damper (shared/data/dyke/README.md), x in cm, F in N, {volt} V"),
             params: dyke_1997().flat(),
             reference: Box::new(dyke_1997()),

@@ -49,7 +49,7 @@ impl Default for ConcealedSpec {
     fn default() -> Self {
         Self {
             effect: "none".into(),
-            base: "bouc_wen".into(),
+            base: models::bouc_wen::Registered::ID.into(),
             excitation: "multisine".into(),
             size: 0.04,
             seed: 1,

@@ -6,6 +6,8 @@
 
 use std::f64::consts::PI;
 
+use model_core::models::{algebraic, bouc_wen, dahl, lugre, tanh};
+use model_core::Model;
 use rand::Rng;
 
 use super::spec::{ConcealedError, ConcealedSpec};
@@ -25,10 +27,11 @@ const AMBIENT_C: f64 = 25.0;
 
 /// Clutch-like truth of each base (flux density in T, torque in N·m): each model fitted once
 /// to `hil-sim simulate --scenario multisine` (`fit --delay off`), rounded.
-pub fn truth(base: &str) -> Option<Vec<(&'static str, f64)>> {
-    Some(match base {
-        "algebraic" => vec![("t0", 1.02), ("k", 29.3), ("alpha", -31.3), ("c", 0.02)],
-        "bouc_wen" => vec![
+const TRUTHS: [(&str, &[(&str, f64)]); 5] = [
+    (algebraic::Registered::ID, &[("t0", 1.02), ("k", 29.3), ("alpha", -31.3), ("c", 0.02)]),
+    (
+        bouc_wen::Registered::ID,
+        &[
             ("alpha", 9.03),
             ("beta", 26.0),
             ("gamma", 0.055),
@@ -38,11 +41,18 @@ pub fn truth(base: &str) -> Option<Vec<(&'static str, f64)>> {
             ("k", 20.1),
             ("x0", -0.117),
         ],
-        "lugre" => {
-            vec![("t0", 2.16), ("k", 24.5), ("alpha", 972.0), ("beta", 0.00292), ("epsilon", 0.0296), ("c", 0.02)]
-        }
-        "tanh" => vec![("t0", 1.93), ("k", 24.4), ("alpha", -0.297), ("beta", 1.21), ("gamma", -1.86), ("c", 0.02)],
-        "dahl" => vec![
+    ),
+    (
+        lugre::Registered::ID,
+        &[("t0", 2.16), ("k", 24.5), ("alpha", 972.0), ("beta", 0.00292), ("epsilon", 0.0296), ("c", 0.02)],
+    ),
+    (
+        tanh::Registered::ID,
+        &[("t0", 1.93), ("k", 24.4), ("alpha", -0.297), ("beta", 1.21), ("gamma", -1.86), ("c", 0.02)],
+    ),
+    (
+        dahl::Registered::ID,
+        &[
             ("f0", -2.22),
             ("K0", 25.0),
             ("C0s", 0.000485),
@@ -52,8 +62,12 @@ pub fn truth(base: &str) -> Option<Vec<(&'static str, f64)>> {
             ("sigma", 57000.0),
             ("eta", 190.0),
         ],
-        _ => return None,
-    })
+    ),
+];
+
+/// The truth of base `base` by parameter name; `None` for a model that is not a base.
+pub fn truth(base: &str) -> Option<Vec<(&'static str, f64)>> {
+    TRUTHS.iter().find(|(id, _)| *id == base).map(|(_, set)| set.to_vec())
 }
 
 /// The truth's flat parameter vector in the registry's order.
