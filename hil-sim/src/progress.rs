@@ -6,7 +6,8 @@ pub trait Progress: Sync {
     fn stage(&self, _name: &str, _total: u64) {}
     /// `n` more steps of the current stage are done.
     fn advance(&self, _n: u64) {}
-    /// A one-line message for the user (a log line, not an error).
+    /// What is being done now, one line for the user (not an error): a bar shows it as its
+    /// message, a log prints it.
     fn message(&self, _msg: &str) {}
 }
 

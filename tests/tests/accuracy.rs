@@ -8,7 +8,7 @@ use hil_sim::sim::accuracy::{self, MAX_R_RMSE};
 fn every_ode_model_meets_the_bound() {
     let path = hil_sim::io::bundled::data_file("dyke/ranran_50.csv").expect("bundled Dyke recording");
     let rec = accuracy::load_dyke(&path).unwrap();
-    let rows = accuracy::run_all(None, false, Some(&rec), &|| {}).unwrap();
+    let rows = accuracy::run_all(None, false, Some(&rec), &hil_sim::progress::NoProgress).unwrap();
     for id in ["bouc_wen", "lugre", "spencer", "dahl", "bouc_wen_asym"] {
         assert!(rows.iter().any(|r| r.model == id), "no accuracy case for {id}");
     }

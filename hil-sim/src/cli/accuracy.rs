@@ -24,7 +24,7 @@ pub fn rows(model: Option<&str>, quick: bool, no_recording: bool) -> anyhow::Res
         None
     } else {
         let path = hil_sim::io::bundled::data_file("dyke/ranran_50.csv").map_err(anyhow::Error::msg)?;
-        Some(accuracy::load_dyke(&path).map_err(anyhow::Error::msg)?)
+        Some(accuracy::load_dyke(&path)?)
     };
     if let Some(m) = model {
         if model_core::registry::find(m).is_none() {
@@ -38,9 +38,9 @@ pub fn rows(model: Option<&str>, quick: bool, no_recording: bool) -> anyhow::Res
             model.unwrap_or("any model")
         );
     }
-    let pb = super::progress(n as u64, "accuracy");
-    let rows = accuracy::run_all(model, quick, rec.as_ref(), &|| pb.inc(1)).map_err(anyhow::Error::msg)?;
-    pb.finish_and_clear();
+    let bar = super::progress::Bar::new(n as u64, "accuracy");
+    let rows = accuracy::run_all(model, quick, rec.as_ref(), &bar)?;
+    bar.finish();
     Ok(rows)
 }
 

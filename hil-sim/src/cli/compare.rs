@@ -49,12 +49,9 @@ pub fn run(a: CompareArgs) -> anyhow::Result<()> {
     // Validation recordings are replayed whole; the split is irrelevant there.
     let val = a.validate.iter().map(|p| load(p, &a, 0.5)).collect::<anyhow::Result<Vec<_>>>()?;
     let opts = FitOptions { rate: a.ch.rate()?, ..Default::default() };
-    let pb = super::progress((models.len() * ident.len()) as u64, "comparing");
-    let c = compare(&ident, &val, &models, &opts, |m, r| {
-        pb.set_message(format!("{m} on {r}"));
-        pb.inc(1);
-    })?;
-    pb.finish_and_clear();
+    let bar = super::progress::Bar::new((models.len() * ident.len()) as u64, "comparing");
+    let c = compare(&ident, &val, &models, &opts, &bar)?;
+    bar.finish();
     if a.json {
         return super::print_json(&json!(c));
     }

@@ -6,7 +6,6 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use hil_sim::closed_loop::{evaluate, LoopReport, LoopScenario, LoopSpec, Run, ScenarioFigures};
-use hil_sim::progress::Progress;
 use hil_sim::sim::plant::ClutchParams;
 use hil_sim::sim::scenario::Scenario;
 use serde_json::{json, Value};
@@ -59,21 +58,6 @@ pub struct LoopArgs {
     pub json: bool,
 }
 
-/// The progress bar as the library's [`Progress`].
-struct Bar(indicatif::ProgressBar);
-
-impl Progress for Bar {
-    fn stage(&self, name: &str, _total: u64) {
-        self.0.set_message(name.to_owned());
-    }
-    fn advance(&self, n: u64) {
-        self.0.inc(n);
-    }
-    fn message(&self, msg: &str) {
-        self.0.println(msg);
-    }
-}
-
 fn write_csv(dir: &Option<PathBuf>, name: &str, r: &Run) -> anyhow::Result<()> {
     if let Some(d) = dir {
         std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
@@ -91,9 +75,9 @@ pub fn run_cmd(a: LoopArgs) -> anyhow::Result<()> {
         None => ClutchParams::default(),
     };
     let spec = LoopSpec { scenario: a.scenario.into(), control_hz: a.control_hz, duration: a.duration, seed: a.seed };
-    let pb = Bar(super::progress(3, "identify"));
-    let report = evaluate(&clutch, &spec, &pb)?;
-    pb.0.finish_and_clear();
+    let bar = super::progress::Bar::new(3, "identify");
+    let report = evaluate(&clutch, &spec, &bar)?;
+    bar.finish();
     let name = report.scenario.name();
     match &report.figures {
         ScenarioFigures::Heating { temp_comp_run, .. } => {

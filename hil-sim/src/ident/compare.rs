@@ -13,6 +13,7 @@ use crate::ident::fit::{fit, Dataset, DelayChoice, FitError, FitOptions, FitResu
 use crate::io::params_file::{ParamsFile, Values};
 use crate::models::replay;
 use crate::numerics::metrics::{metrics, Metrics};
+use crate::progress::Progress;
 
 /// A named dataset (the name is what the tables print, e.g. the file stem).
 #[derive(Clone, Debug)]
@@ -74,16 +75,18 @@ pub fn compare(
     validate: &[Named],
     models: &[String],
     opts: &FitOptions,
-    mut progress: impl FnMut(&str, &str),
+    progress: &dyn Progress,
 ) -> Result<Comparison, FitError> {
     let opts = &FitOptions { delay: DelayChoice::Off, ..*opts };
     let mut fits = Vec::new();
     let mut averaged = Vec::new();
+    progress.stage("comparing", (models.len() * identify.len()) as u64);
     for id in models {
         let mut results: Vec<FitResult> = Vec::with_capacity(identify.len());
         for rec in identify {
             let r = fit(id, &rec.data, opts)?;
-            progress(id, &rec.name);
+            progress.message(&format!("{id} on {}", rec.name));
+            progress.advance(1);
             fits.push(PerRecording {
                 recording: rec.name.clone(),
                 model: id.clone(),
@@ -246,7 +249,6 @@ mod tests {
             [1.0, 3.0].iter().map(|f| Named { name: format!("sine {f} Hz"), data: recording(*f, &truth) }).collect();
         let val = vec![Named { name: "sine 2 Hz".into(), data: recording(2.0, &truth) }];
         let models = vec!["bouc_wen".to_owned(), "algebraic".to_owned()];
-        let mut calls = 0;
         // The truth was generated with backward differences: fit with the same estimator, and
         // let the solver converge on noiseless data.
         let opts = FitOptions {
@@ -255,8 +257,15 @@ mod tests {
             polish_iterations: 30,
             ..FitOptions::default()
         };
-        let c = compare(&ident, &val, &models, &opts, |_, _| calls += 1).unwrap();
-        assert_eq!(calls, 4);
+        struct Count(std::sync::atomic::AtomicU64);
+        impl Progress for Count {
+            fn advance(&self, n: u64) {
+                self.0.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+            }
+        }
+        let calls = Count(std::sync::atomic::AtomicU64::new(0));
+        let c = compare(&ident, &val, &models, &opts, &calls).unwrap();
+        assert_eq!(calls.0.into_inner(), 4);
         assert_eq!(c.fits.len(), 4);
         assert_eq!(c.averaged.len(), 2);
         let bw = c.validation.iter().find(|v| v.model == "bouc_wen").unwrap();

@@ -17,11 +17,27 @@ use ode_solvers::dop_shared::OutputType;
 use ode_solvers::{dopri5::Dopri5, DVector, System};
 use rayon::prelude::*;
 use serde::Serialize;
+use thiserror::Error;
 
 use crate::io::recording::Recording;
 use crate::models::reference::{Case, Command, Input, Reference};
 use crate::models::{replay, RateSpec};
+use crate::progress::Progress;
 use crate::sim::excitation::Excitation;
+
+/// Why an accuracy run could not be made.
+#[derive(Debug, Error)]
+pub enum AccuracyError {
+    /// The f64 reference could not be integrated.
+    #[error("{0}")]
+    Reference(String),
+    #[error(transparent)]
+    Replay(#[from] crate::models::ReplayError),
+    #[error(transparent)]
+    Recording(#[from] crate::io::recording::RecordingError),
+    #[error("{model} [{label}]: {source}")]
+    Case { model: String, label: String, source: Box<AccuracyError> },
+}
 
 /// The acceptance bound on the R-RMSE of the difference.
 pub const MAX_R_RMSE: f64 = 0.005;
@@ -96,14 +112,16 @@ fn advance<F: Fn(f64) -> Input>(
     t0: f64,
     t1: f64,
     input: F,
-) -> Result<Vec<f64>, String> {
+) -> Result<Vec<f64>, AccuracyError> {
     let mut solver = dopri5(Sys { model, input }, s, t0, t1, t1 - t0, OutputType::Sparse);
-    solver.integrate().map_err(|e| format!("reference integration failed at t = {t0}: {e}"))?;
+    solver
+        .integrate()
+        .map_err(|e| AccuracyError::Reference(format!("reference integration failed at t = {t0}: {e}")))?;
     solver
         .y_out()
         .last()
         .map(|v| v.as_slice().to_vec())
-        .ok_or_else(|| "reference integrator returned nothing".to_owned())
+        .ok_or_else(|| AccuracyError::Reference("reference integrator returned nothing".to_owned()))
 }
 
 /// Reference output at every sample for a smooth input: one adaptive run over the whole
@@ -113,18 +131,22 @@ fn dense_outputs(
     n: usize,
     dt: f64,
     input_at: impl Fn(f64) -> Input,
-) -> Result<Vec<f64>, String> {
+) -> Result<Vec<f64>, AccuracyError> {
     let first = input_at(0.0);
     let s0 = model.init(&first);
     if s0.len() != model.dim() {
-        return Err(format!("reference init gave {} states, dim() says {}", s0.len(), model.dim()));
+        return Err(AccuracyError::Reference(format!(
+            "reference init gave {} states, dim() says {}",
+            s0.len(),
+            model.dim()
+        )));
     }
     let t_end = (n - 1) as f64 * dt;
     let mut solver = dopri5(Sys { model, input: &input_at }, &s0, 0.0, t_end, dt, OutputType::Dense);
-    solver.integrate().map_err(|e| format!("reference integration failed: {e}"))?;
+    solver.integrate().map_err(|e| AccuracyError::Reference(format!("reference integration failed: {e}")))?;
     let (ts, ys) = (solver.x_out(), solver.y_out());
     if ts.len() < n {
-        return Err(format!("dense output gave {} of {n} samples", ts.len()));
+        return Err(AccuracyError::Reference(format!("dense output gave {} of {n} samples", ts.len())));
     }
     Ok(ts.iter().zip(ys).take(n).map(|(t, y)| model.output(y.as_slice(), &input_at(*t))).collect())
 }
@@ -136,11 +158,15 @@ fn reference_outputs(
     dt: f64,
     at: impl Fn(usize) -> Input,
     on_interval: impl Fn(usize, f64) -> Input + Sync,
-) -> Result<Vec<f64>, String> {
+) -> Result<Vec<f64>, AccuracyError> {
     let first = at(0);
     let mut s = model.init(&first);
     if s.len() != model.dim() {
-        return Err(format!("reference init gave {} states, dim() says {}", s.len(), model.dim()));
+        return Err(AccuracyError::Reference(format!(
+            "reference init gave {} states, dim() says {}",
+            s.len(),
+            model.dim()
+        )));
     }
     let mut out = Vec::with_capacity(n);
     out.push(model.output(&s, &first));
@@ -172,7 +198,7 @@ fn compare(case: &Case, excitation: String, fs: f64, core: &[f32], held: usize, 
 }
 
 /// Check one case on a synthetic excitation of `duration` seconds sampled at `fs` Hz.
-pub fn synthetic(case: &Case, exc: &Excitation, fs: f64, duration: f64) -> Result<Row, String> {
+pub fn synthetic(case: &Case, exc: &Excitation, fs: f64, duration: f64) -> Result<Row, AccuracyError> {
     let dt = 1.0 / fs;
     let n = (duration * fs).round() as usize + 1;
     let u = match case.command {
@@ -195,20 +221,20 @@ pub fn synthetic(case: &Case, exc: &Excitation, fs: f64, duration: f64) -> Resul
             }
         })
         .collect();
-    let core = replay(case.model, &case.params, dt as f32, RateSpec::Backward, &samples).map_err(|e| e.to_string())?;
+    let core = replay(case.model, &case.params, dt as f32, RateSpec::Backward, &samples)?;
     let r = dense_outputs(case.reference.as_ref(), n, dt, input_at)?;
     Ok(compare(case, exc.name(), fs, &core.y, core.held, &r))
 }
 
 /// Check one case on the real displacement `D` (cm) and command `Y` (V) of a Dyke
 /// recording, at its own sampling rate.
-pub fn dyke(case: &Case, rec: &Recording) -> Result<Row, String> {
-    let x = rec.channel("D").map_err(|e| e.to_string())?;
-    let u = rec.channel("Y").map_err(|e| e.to_string())?;
-    let dt = rec.mean_dt("t").map_err(|e| e.to_string())?;
+pub fn dyke(case: &Case, rec: &Recording) -> Result<Row, AccuracyError> {
+    let x = rec.channel("D")?;
+    let u = rec.channel("Y")?;
+    let dt = rec.mean_dt("t")?;
     let n = x.len();
     let samples: Vec<Sample> = x.iter().zip(u).map(|(x, u)| Sample::new(*x as f32).with_command(*u as f32)).collect();
-    let core = replay(case.model, &case.params, dt as f32, RateSpec::Backward, &samples).map_err(|e| e.to_string())?;
+    let core = replay(case.model, &case.params, dt as f32, RateSpec::Backward, &samples)?;
     // The f32 core sees x and u in f32: give the reference the same rounded values.
     let xf: Vec<f64> = x.iter().map(|v| f64::from(*v as f32)).collect();
     let uf: Vec<f64> = u.iter().map(|v| f64::from(*v as f32)).collect();
@@ -252,8 +278,8 @@ pub fn run_all(
     filter: Option<&str>,
     quick: bool,
     dyke_recording: Option<&Recording>,
-    progress: &(dyn Fn() + Sync),
-) -> Result<Vec<Row>, String> {
+    progress: &dyn Progress,
+) -> Result<Vec<Row>, AccuracyError> {
     let cases: Vec<Case> =
         crate::models::reference::cases().into_iter().filter(|c| filter.is_none_or(|f| c.model == f)).collect();
     // (case index, synthetic excitation with duration and rate, or the recording)
@@ -275,10 +301,14 @@ pub fn run_all(
             let row = match (job, dyke_recording) {
                 (Some((e, d, fs)), _) => synthetic(case, e, *fs, *d),
                 (None, Some(rec)) => dyke(case, rec),
-                (None, None) => Err("no recording".into()),
+                (None, None) => Err(AccuracyError::Reference("no recording".into())),
             };
-            progress();
-            row.map_err(|e| format!("{} [{}]: {e}", case.model, case.label))
+            progress.advance(1);
+            row.map_err(|e| AccuracyError::Case {
+                model: case.model.to_owned(),
+                label: case.label.clone(),
+                source: Box::new(e),
+            })
         })
         .collect()
 }
@@ -293,6 +323,6 @@ pub fn count_jobs(filter: Option<&str>, quick: bool, with_dyke: bool) -> usize {
 }
 
 /// Read the Dyke recording used by the damper cases.
-pub fn load_dyke(path: &Path) -> Result<Recording, String> {
-    Recording::read_csv(path).map_err(|e| e.to_string())
+pub fn load_dyke(path: &Path) -> Result<Recording, AccuracyError> {
+    Ok(Recording::read_csv(path)?)
 }
