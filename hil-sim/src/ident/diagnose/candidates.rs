@@ -18,6 +18,7 @@ use serde::Serialize;
 
 use super::augment::{Fitted, Term, Transform};
 use crate::ident::fit::Dataset;
+use crate::numerics::stats::{mean, std};
 
 /// What an auxiliary channel was taken to be.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -81,15 +82,6 @@ fn corr(a: &[f64], b: &[f64]) -> f64 {
     } else {
         0.0
     }
-}
-
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len().max(1) as f64
-}
-
-fn std(v: &[f64]) -> f64 {
-    let m = mean(v);
-    (v.iter().map(|a| (a - m) * (a - m)).sum::<f64>() / v.len().max(1) as f64).sqrt()
 }
 
 fn centred(v: &[f64]) -> Vec<f64> {

@@ -113,9 +113,7 @@ fn excitation(name: &str, t: &[f64], duration: f64, rng: &mut impl Rng) -> Vec<f
 }
 
 /// Root-mean-square of `v`.
-pub fn rms(v: &[f64]) -> f64 {
-    (v.iter().map(|a| a * a).sum::<f64>() / v.len().max(1) as f64).sqrt()
-}
+pub use crate::numerics::stats::rms;
 
 /// The base model's torque for the field `b` the model sees (its true rate attached).
 pub fn torque(base: &str, p: &[f32], b: &[f64], dt: f64) -> Result<Vec<f64>, ConcealedError> {
