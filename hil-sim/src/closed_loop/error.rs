@@ -8,6 +8,8 @@ use thiserror::Error;
 pub enum LoopError {
     #[error("controller parameters: {0}")]
     Params(#[from] ParamError),
+    #[error("{field} = {value}: {reason}")]
+    Spec { field: &'static str, value: f64, reason: &'static str },
     #[error("identification failed: {0}")]
     Identify(String),
     /// [`evaluate`](super::evaluate) could not identify the clutch.

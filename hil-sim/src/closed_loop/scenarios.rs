@@ -117,8 +117,27 @@ pub fn compare(
     Ok((lp, bl))
 }
 
+impl LoopSpec {
+    /// A rate and a duration that leave samples to score.
+    pub fn check(&self) -> Result<(), LoopError> {
+        let spec = |field, value, reason| Err(LoopError::Spec { field, value, reason });
+        if !(self.control_hz.is_finite() && self.control_hz > 0.0) {
+            return spec("control_hz", self.control_hz, "the control rate must be a finite number of Hz above 0");
+        }
+        if !(self.duration.is_finite() && self.duration > SETTLE_S) {
+            return spec(
+                "duration",
+                self.duration,
+                "must be a finite number of seconds above 0.5 (the first 0.5 s are not scored)",
+            );
+        }
+        Ok(())
+    }
+}
+
 /// Identify `clutch` and run `spec`'s scenario (see [`LoopScenario`]).
 pub fn evaluate(clutch: &ClutchParams, spec: &LoopSpec, progress: &dyn Progress) -> Result<LoopReport, LoopError> {
+    spec.check()?;
     progress.stage("identify", 3);
     let id = identify(clutch, spec.control_hz, spec.seed).map_err(|e| LoopError::Identifying(Box::new(e)))?;
     progress.advance(1);

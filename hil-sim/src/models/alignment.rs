@@ -10,9 +10,33 @@
 //! sensors'.
 
 use model_core::Kin;
+use thiserror::Error;
 
 /// Largest |delay| the fit searches, in samples (±2.7 ms at the Dyke files' 3 kHz).
 pub const MAX_DELAY_SAMPLES: f64 = 8.0;
+
+/// Why delays cannot be applied to a recording.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum DelayError {
+    #[error("delay {delay_s} s is not a finite number of seconds")]
+    NotFinite { delay_s: f64 },
+    #[error("a delay of {delay_s} s leaves no sample of the {duration_s} s recording to score")]
+    NothingCovered { delay_s: f64, duration_s: f64 },
+}
+
+/// Delays `ds` (samples, sampling step `dt` seconds) that leave at least one of `n` samples
+/// [`covered`]: finite, and shorter than the recording.
+pub fn check(n: usize, dt: f64, ds: &[f64]) -> Result<(), DelayError> {
+    if let Some(d) = ds.iter().find(|d| !d.is_finite()) {
+        return Err(DelayError::NotFinite { delay_s: d * dt });
+    }
+    let (lo, hi) = covered(n, ds);
+    if lo >= hi {
+        let longest = ds.iter().fold(0.0f64, |a, d| if d.abs() > a.abs() { *d } else { a });
+        return Err(DelayError::NothingCovered { delay_s: longest * dt, duration_s: n as f64 * dt });
+    }
+    Ok(())
+}
 
 /// Position `i + d` of `n` samples as (lower index, upper index, weight of the upper one).
 fn bracket(i: usize, d: f64, n: usize) -> (usize, usize, f64) {
@@ -89,6 +113,11 @@ mod tests {
         assert_eq!(covered(100, &[0.0, 0.0]), (0, 100));
         assert_eq!(covered(100, &[2.5, -1.2]), (2, 97));
         assert_eq!(covered(3, &[8.0]), (0, 0));
+        assert!(check(3, 1.0, &[8.0]).is_err());
+        assert!(check(100, 1e-3, &[1e12, 0.0]).is_err());
+        assert!(check(100, 1e-3, &[-5e3, 0.0]).is_err());
+        assert!(check(100, 1e-3, &[f64::NAN]).is_err());
+        assert_eq!(check(100, 1e-3, &[2.5, -1.2]), Ok(()));
     }
 
     #[test]

@@ -8,7 +8,7 @@ use thiserror::Error;
 
 use crate::io::recording::{Channels, Recording};
 use crate::models::{visit, RateSpec, Visit};
-use crate::numerics::metrics::{metrics, Metrics};
+use crate::numerics::metrics::{try_metrics, Metrics, NoSamples};
 
 /// What a replay measured.
 #[derive(Clone, Debug, Serialize)]
@@ -43,6 +43,7 @@ pub fn replay_recording(
     let u = ch.command.as_deref().map(|c| rec.channel(c)).transpose()?;
     let dt = rec.mean_dt(&ch.time)?;
     let (d, d_u) = (delays_s.0 / dt, if u.is_some() { delays_s.1 / dt } else { 0.0 });
+    crate::models::alignment::check(x.len(), dt, &[d, d_u])?;
     let (x, u) = crate::models::alignment::shift_channels(x, u, d, d_u);
     let samples = samples(&x, u.as_deref());
     let out = replay(model, params, dt as f32, rate, &samples)?;
@@ -57,7 +58,7 @@ pub fn replay_recording(
         model: model.to_owned(),
         samples: x.len(),
         dt_s: dt,
-        metrics: metrics(&part(y), &part(&model_output), Some((&part(&dx), &part(&ddx)))),
+        metrics: try_metrics(&part(y), &part(&model_output), Some((&part(&dx), &part(&ddx))))?,
         held: out.held,
         time: t.to_vec(),
         measured: y.to_vec(),
@@ -99,6 +100,10 @@ pub enum ReplayError {
     Recording(#[from] crate::io::recording::RecordingError),
     #[error("unknown model `{0}` (see `hil-sim models`)")]
     UnknownModel(String),
+    #[error(transparent)]
+    Delay(#[from] crate::models::alignment::DelayError),
+    #[error("{0}")]
+    NothingScored(#[from] NoSamples),
     #[error("model `{model}`: {source}")]
     Params { model: String, source: ParamError },
 }

@@ -78,6 +78,19 @@ pub fn metrics(measured: &[f64], model: &[f64], rates: Option<(&[f64], &[f64])>)
     }
 }
 
+/// Comparisons over no sample have no score.
+#[derive(Clone, Copy, Debug, thiserror::Error, PartialEq)]
+#[error("no sample to score")]
+pub struct NoSamples;
+
+/// [`metrics`], refusing an empty comparison (which would read as a perfect score).
+pub fn try_metrics(measured: &[f64], model: &[f64], rates: Option<(&[f64], &[f64])>) -> Result<Metrics, NoSamples> {
+    if measured.is_empty() || model.is_empty() {
+        return Err(NoSamples);
+    }
+    Ok(metrics(measured, model, rates))
+}
+
 /// R-RMSE (seed 000 eq. 20) of `a` against the reference `reference`.
 pub fn r_rmse(reference: &[f64], a: &[f64]) -> f64 {
     metrics(reference, a, None).r_rmse
@@ -102,6 +115,12 @@ mod tests {
         assert!((m.r2 - 0.2).abs() < 1e-12);
         assert!((m.gof - (1.0 - 0.8f64.sqrt())).abs() < 1e-12);
         assert!((m.avg_dev - (-(1.0 + 0.5 + 1.0 / 3.0 + 0.25) / 4.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn no_sample_is_no_score() {
+        assert_eq!(try_metrics(&[], &[], None), Err(NoSamples));
+        assert!(try_metrics(&[1.0], &[1.0], None).is_ok());
     }
 
     #[test]

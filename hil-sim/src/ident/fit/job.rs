@@ -54,7 +54,7 @@ impl FitRun {
 pub enum FitJobError {
     #[error(transparent)]
     Dataset(#[from] DatasetError),
-    #[error("fitting `{model}`: {source}")]
+    #[error("fitting `{model}`")]
     Fit { model: String, source: FitError },
     #[error("{}: {reason}", path.display())]
     Save { path: PathBuf, reason: String },

@@ -41,6 +41,17 @@ use global::SwarmOptions;
 pub use crate::ident::dataset::{Dataset, DatasetError};
 use objective::Objective;
 
+/// Both parts keep samples to score under the delays `ds` (samples, step `dt` s).
+fn scored_parts(train: &[usize], heldout: &[usize], ds: (f64, f64), dt: f64) -> Result<(), FitError> {
+    for (part, r) in [("training", train), ("held-out", heldout)] {
+        if r.is_empty() {
+            let delay_s = if ds.0.abs() >= ds.1.abs() { ds.0 } else { ds.1 } * dt;
+            return Err(FitError::NothingScored { part, delay_s });
+        }
+    }
+    Ok(())
+}
+
 /// Why a fit could not run.
 #[derive(Debug, Error)]
 pub enum FitError {
@@ -58,6 +69,10 @@ pub enum FitError {
     Swarm { model: String, reason: String },
     #[error("{model}: replay of the fitted set failed: {reason}")]
     Replay { model: String, reason: String },
+    #[error(transparent)]
+    Delay(#[from] crate::models::alignment::DelayError),
+    #[error("the {part} part has no sample left to score with a delay of {delay_s} s")]
+    NothingScored { part: &'static str, delay_s: f64 },
 }
 
 /// Whether the fit aligns the input channel with the output ([`crate::models::alignment`]).
@@ -172,6 +187,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         (DelayChoice::Off, _) => (fit_at(&kin, &sp)?, (0.0, 0.0)),
         (DelayChoice::Fixed(s, s_u), _) => {
             let d = (s / data.dt, if data.command.is_some() { s_u / data.dt } else { 0.0 });
+            crate::models::alignment::check(data.len(), data.dt, &[d.0, d.1])?;
             let mut shifted = Vec::new();
             crate::models::alignment::shift_kin(&kin, d.0, d.1, &mut shifted);
             (fit_at(&shifted, &sp)?, d)
@@ -243,6 +259,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     let unflagged: Vec<usize> = data.heldout_unflagged().into_iter().filter(|i| (lo..hi).contains(i)).collect();
     let all_heldout: Vec<usize> = (data.train_end..n).filter(|i| (lo..hi).contains(i)).collect();
     let rows: Vec<usize> = rows.into_iter().filter(|i| (lo..hi).contains(i)).collect();
+    scored_parts(&rows, &all_heldout, (delay, delay_u), data.dt)?;
     let named = ParamsFile::from_flat(id, None, &p32).map(|f| f.params).unwrap_or(Values::Flat(params.clone()));
     Ok(FitResult {
         model: id.to_owned(),

@@ -1,0 +1,91 @@
+//! Hostile numbers on the command line and in the files (issue 18): each gives a one-line
+//! error naming the field and the problem, or a correct result; never a score over no
+//! sample, a hang, or a file with NaN in it. Inputs are generated here.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn hil_sim(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_hil-sim")).args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// A fresh scratch folder for one test.
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hil-sim-hostile-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A 3 s recording at 1 kHz, `t,b,torque`, with `row` replacing the generated rows where it
+/// returns `Some`.
+fn recording(dir: &Path, name: &str, row: impl Fn(usize, f64, f64, f64) -> Option<String>) -> PathBuf {
+    let mut s = String::from("t,b,torque\n");
+    for i in 0..3000 {
+        let t = i as f64 / 1000.0;
+        let b = 0.5 * (2.0 * std::f64::consts::PI * 1.3 * t).sin() + 0.2 * (2.0 * std::f64::consts::PI * 3.1 * t).sin();
+        let y = 300.0 * b + 20.0 * (50.0 * b).tanh();
+        s += &row(i, t, b, y).unwrap_or_else(|| format!("{t:.4},{b:.6},{y:.5}"));
+        s.push('\n');
+    }
+    let p = dir.join(name);
+    std::fs::write(&p, s).unwrap();
+    p
+}
+
+fn plain(dir: &Path) -> PathBuf {
+    recording(dir, "rec.csv", |_, _, _, _| None)
+}
+
+/// One line on stderr, a non-zero exit, and every `needles` in it.
+fn refused(r: &(i32, String, String), needles: &[&str]) {
+    let (code, out, err) = r;
+    assert_ne!(*code, 0, "exit 0; stdout {out}");
+    assert_eq!(err.trim().lines().count(), 1, "not one line: {err}");
+    for n in needles {
+        assert!(err.contains(n), "`{n}` not in {err}");
+    }
+}
+
+#[test]
+fn a_delay_longer_than_the_recording_is_refused_not_scored_perfect() {
+    let d = scratch("delay");
+    let rec = plain(&d);
+    let rec = rec.to_str().unwrap();
+    for delay in ["1e9", "-1e9", "2.5", "-2.5", "1e300,0"] {
+        let r = hil_sim(&["fit", rec, "--model", "algebraic", &format!("--delay={delay}")]);
+        refused(&r, &["delay"]);
+    }
+    // Replay with the delay in the parameter file.
+    let save = d.join("saved");
+    let r = hil_sim(&["fit", rec, "--model", "algebraic", "--delay", "off", "--save", save.to_str().unwrap()]);
+    assert_eq!(r.0, 0, "{}", r.2);
+    let params = std::fs::read_to_string(save.join("algebraic.json")).unwrap();
+    for delay in ["1e9", "-5", "-1e300"] {
+        let p = d.join(format!("p{delay}.json"));
+        std::fs::write(&p, params.replacen("\"model\"", &format!("\"delay_s\": {delay}, \"model\""), 1)).unwrap();
+        let r = hil_sim(&["replay", rec, "--params", p.to_str().unwrap(), "--json"]);
+        refused(&r, &["rec.csv", "delay", "no sample"]);
+    }
+    // A delay inside the recording still scores.
+    let p = d.join("ok.json");
+    std::fs::write(&p, params.replacen("\"model\"", "\"delay_s\": 0.001, \"model\"", 1)).unwrap();
+    let r = hil_sim(&["replay", rec, "--params", p.to_str().unwrap(), "--json"]);
+    assert_eq!(r.0, 0, "{}", r.2);
+    assert!(r.1.contains("\"n\": 2999"), "{}", r.1);
+}
+
+#[test]
+fn a_loop_duration_that_scores_nothing_is_refused() {
+    for dur in ["0", "nan", "-1", "0.4"] {
+        let r = hil_sim(&["loop", "--scenario", "multisine", &format!("--duration={dur}")]);
+        refused(&r, &["duration"]);
+    }
+    let r = hil_sim(&["loop", "--scenario", "multisine", "--control-hz=0"]);
+    refused(&r, &["control"]);
+}
