@@ -3,10 +3,28 @@
 //! sample, a hang, or a file with NaN in it. Inputs are generated here.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// Longest any of these runs may take, s: each is refused from its numbers, before work.
+const DEADLINE_S: u64 = 60;
 
 fn hil_sim(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_hil-sim")).args(args).output().unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_hil-sim"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if start.elapsed() > Duration::from_secs(DEADLINE_S) {
+            child.kill().unwrap();
+            panic!("hil-sim {args:?} still running after {DEADLINE_S} s");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let out = child.wait_with_output().unwrap();
     (
         out.status.code().unwrap_or(-1),
         String::from_utf8_lossy(&out.stdout).into_owned(),
@@ -88,4 +106,33 @@ fn a_loop_duration_that_scores_nothing_is_refused() {
     }
     let r = hil_sim(&["loop", "--scenario", "multisine", "--control-hz=0"]);
     refused(&r, &["control"]);
+}
+
+#[test]
+fn sizes_are_bounded_from_the_numbers_before_any_work() {
+    for dur in ["inf", "1e9", "1e300", "200"] {
+        let r = hil_sim(&["loop", "--scenario", "multisine", &format!("--duration={dur}")]);
+        refused(&r, &["duration"]);
+    }
+    let r = hil_sim(&["loop", "--scenario", "heating", "--control-hz=1e9"]);
+    refused(&r, &["control steps"]);
+    let d = scratch("sizes");
+    let cases = [
+        ("duration_s = 1e9\n", "duration_s"),
+        ("duration_s = 1e6\n", "duration_s"),
+        ("duration_s = 2.0\n[clutch.magnetic]\nn_play = 100000000\n", "clutch.magnetic.n_play"),
+        ("duration_s = 2.0\n[clutch]\npwm_substeps = 100000000\n", "clutch.pwm_substeps"),
+        ("duration_s = 2.0\n[clutch.coil]\npwm_hz = 1e12\n", "clutch.coil.pwm_hz"),
+        ("duration_s = 90.0\ncontrol_hz = 100000.0\n", "control steps"),
+    ];
+    for (i, (toml, field)) in cases.iter().enumerate() {
+        let p = d.join(format!("s{i}.toml"));
+        std::fs::write(&p, toml).unwrap();
+        let out = d.join(format!("s{i}.csv"));
+        let r = hil_sim(&["simulate", "--scenario", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        refused(&r, &[&format!("s{i}.toml"), field]);
+        assert!(!out.exists(), "{toml}: wrote {}", out.display());
+        let r = hil_sim(&["loop", "--scenario", "steps", "--clutch", p.to_str().unwrap()]);
+        refused(&r, &[&format!("s{i}.toml"), field]);
+    }
 }

@@ -10,6 +10,8 @@ pub enum LoopError {
     Params(#[from] ParamError),
     #[error("{field} = {value}: {reason}")]
     Spec { field: &'static str, value: f64, reason: &'static str },
+    #[error(transparent)]
+    Limit(#[from] crate::sim::plant::limits::LimitError),
     #[error("identification failed: {0}")]
     Identify(String),
     /// [`evaluate`](super::evaluate) could not identify the clutch.

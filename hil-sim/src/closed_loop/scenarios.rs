@@ -118,8 +118,19 @@ pub fn compare(
 }
 
 impl LoopSpec {
-    /// A rate and a duration that leave samples to score.
-    pub fn check(&self) -> Result<(), LoopError> {
+    /// Length of the scenario's longest run, s (the identification runs 9 s).
+    pub fn longest_run_s(&self) -> f64 {
+        let own = match self.scenario {
+            LoopScenario::Multisine => T_START + self.duration,
+            LoopScenario::Heating => T_START + 90.0,
+            _ => 0.0,
+        };
+        own.max(9.0)
+    }
+
+    /// A rate and a duration that leave samples to score, and runs of `clutch` within
+    /// [`crate::sim::plant::limits`].
+    pub fn check(&self, clutch: &ClutchParams) -> Result<(), LoopError> {
         let spec = |field, value, reason| Err(LoopError::Spec { field, value, reason });
         if !(self.control_hz.is_finite() && self.control_hz > 0.0) {
             return spec("control_hz", self.control_hz, "the control rate must be a finite number of Hz above 0");
@@ -131,13 +142,18 @@ impl LoopSpec {
                 "must be a finite number of seconds above 0.5 (the first 0.5 s are not scored)",
             );
         }
-        Ok(())
+        clutch.check_run(self.longest_run_s(), self.control_hz).map_err(|mut e| {
+            if e.field == "duration_s" && self.scenario == LoopScenario::Multisine {
+                (e.field, e.value) = ("duration", self.duration);
+            }
+            LoopError::Limit(e)
+        })
     }
 }
 
 /// Identify `clutch` and run `spec`'s scenario (see [`LoopScenario`]).
 pub fn evaluate(clutch: &ClutchParams, spec: &LoopSpec, progress: &dyn Progress) -> Result<LoopReport, LoopError> {
-    spec.check()?;
+    spec.check(clutch)?;
     progress.stage("identify", 3);
     let id = identify(clutch, spec.control_hz, spec.seed).map_err(|e| LoopError::Identifying(Box::new(e)))?;
     progress.advance(1);

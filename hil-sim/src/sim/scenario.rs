@@ -322,6 +322,9 @@ impl Scenario {
         if !(c.thermal.capacity > 0.0 && c.thermal.r_th > 0.0) {
             return bad("clutch.thermal: capacity and r_th must be > 0");
         }
+        if let Err(e) = c.check_run(s.duration_s, s.control_hz) {
+            return bad(&e.to_string());
+        }
         Ok(s)
     }
 }

@@ -8,6 +8,7 @@
 
 pub mod coil;
 pub mod fluid;
+pub mod limits;
 pub mod magnetic;
 pub mod motor;
 pub mod sensors;
