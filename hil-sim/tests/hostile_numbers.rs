@@ -136,3 +136,31 @@ fn sizes_are_bounded_from_the_numbers_before_any_work() {
         refused(&r, &[&format!("s{i}.toml"), field]);
     }
 }
+
+#[test]
+fn simulate_refuses_unphysical_scenarios_and_writes_no_absurd_file() {
+    let d = scratch("physical");
+    let mut cases: Vec<(String, &str)> = Vec::new();
+    // Every float of the clutch tables, NaN and infinite in turn (generated from the field list).
+    for (table, field) in
+        [("clutch.fluid", "tau_sat"), ("clutch.fluid", "gap"), ("clutch.thermal", "r_th"), ("clutch", "initial_c")]
+    {
+        for v in ["nan", "inf", "-inf"] {
+            cases.push((format!("duration_s = 2.0\n[{table}]\n{field} = {v}\n"), field));
+        }
+    }
+    cases.push(("duration_s = 2.0\n[clutch.fluid]\ngap = 1e-300\n".into(), "clutch.fluid.gap"));
+    cases.push(("duration_s = 2.0\n[clutch]\ninitial_c = -300.0\n".into(), "clutch.initial_c"));
+    cases.push(("duration_s = 2.0\n[clutch]\nambient_c = -273.15\n".into(), "clutch.ambient_c"));
+    cases.push(("duration_s = 1e-9\n".into(), "duration_s"));
+    // Finite but absurd: the run diverges, and the recording is refused.
+    cases.push(("duration_s = 2.0\n[clutch.fluid]\neta40 = 1e300\n".into(), "diverged"));
+    for (i, (toml, needle)) in cases.iter().enumerate() {
+        let p = d.join(format!("p{i}.toml"));
+        std::fs::write(&p, toml).unwrap();
+        let out = d.join(format!("p{i}.csv"));
+        let r = hil_sim(&["simulate", "--scenario", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+        refused(&r, &[&format!("p{i}.toml"), needle]);
+        assert!(!out.exists(), "{toml}: wrote {}", out.display());
+    }
+}

@@ -132,7 +132,7 @@ pub fn run_cmd(a: SimulateArgs) -> anyhow::Result<()> {
         );
     }
     let pb = super::progress(1, &sc.name);
-    let rec = hil_sim::closed_loop::record::record(&sc)?;
+    let rec = hil_sim::closed_loop::record::record(&sc).with_context(|| format!("simulating {name}"))?;
     pb.finish_and_clear();
     let (rows, r, k0) = (rec.recording.len(), &rec.run, rec.first);
     if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {

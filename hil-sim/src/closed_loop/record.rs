@@ -52,7 +52,28 @@ pub fn record(sc: &Scenario) -> Result<Recorded, LoopError> {
         })
         .collect();
     let recording = Recording::from_columns(Path::new(&format!("{}.csv", sc.name)), columns, Vec::new());
+    check_rows(sc, &recording)?;
     Ok(Recorded { recording, run: r, first: k0 })
+}
+
+/// Largest magnitude a recorded value may have (N·m, T, A, °C, rad/s, s): beyond it the
+/// simulation diverged.
+pub const MAX_RECORDED: f64 = 1e9;
+
+/// A recording worth writing: at least one row, every value finite and within
+/// ±[`MAX_RECORDED`].
+fn check_rows(sc: &Scenario, rec: &Recording) -> Result<(), LoopError> {
+    let name = sc.name.clone();
+    if rec.is_empty() {
+        return Err(LoopError::EmptyRecording { name, duration_s: sc.duration_s, record_hz: sc.record_hz });
+    }
+    for c in &rec.columns {
+        if let Some((row, value)) = c.values.iter().enumerate().find(|(_, v)| !v.is_finite() || v.abs() > MAX_RECORDED)
+        {
+            return Err(LoopError::NonFinite { name, column: c.name.clone(), row: row + 1, value: *value });
+        }
+    }
+    Ok(())
 }
 
 /// `v` to `decimals` decimal places, as a recorder with that resolution stores it.

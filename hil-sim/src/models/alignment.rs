@@ -18,9 +18,9 @@ pub const MAX_DELAY_SAMPLES: f64 = 8.0;
 /// Why delays cannot be applied to a recording.
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum DelayError {
-    #[error("delay {delay_s} s is not a finite number of seconds")]
+    #[error("delay {} s is not a finite number of seconds", crate::numerics::shown(*delay_s))]
     NotFinite { delay_s: f64 },
-    #[error("a delay of {delay_s} s leaves no sample of the {duration_s} s recording to score")]
+    #[error("a delay of {} s leaves no sample of the {duration_s} s recording to score", crate::numerics::shown(*delay_s))]
     NothingCovered { delay_s: f64, duration_s: f64 },
 }
 

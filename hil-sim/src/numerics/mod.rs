@@ -8,3 +8,13 @@ pub mod metrics;
 pub mod nnls;
 pub mod stats;
 pub mod units;
+
+/// A number for a message: plain when of ordinary size, in e-notation when huge or tiny
+/// (so `1e-300` does not print 300 zeros).
+pub fn shown(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-4..1e9).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}

@@ -322,11 +322,37 @@ impl Scenario {
         if !(c.thermal.capacity > 0.0 && c.thermal.r_th > 0.0) {
             return bad("clutch.thermal: capacity and r_th must be > 0");
         }
-        if let Err(e) = c.check_run(s.duration_s, s.control_hz) {
+        if let Some(field) = non_finite(&s) {
+            return bad(&format!("{field}: not a finite number"));
+        }
+        if let Err(e) = c.check_run(s.duration_s, s.control_hz).and_then(|()| c.check_physical()) {
             return bad(&e.to_string());
+        }
+        if s.duration_s * s.record_hz < 2.0 {
+            return bad(&format!(
+                "duration_s = {}: gives {:.3} rows at record_hz = {} Hz, need at least 2",
+                crate::numerics::shown(s.duration_s),
+                s.duration_s * s.record_hz,
+                s.record_hz
+            ));
         }
         Ok(s)
     }
+}
+
+/// The dotted name of the first number of `s` that is NaN or infinite.
+fn non_finite(s: &Scenario) -> Option<String> {
+    fn walk(prefix: &str, v: &toml::Value) -> Option<String> {
+        match v {
+            toml::Value::Float(f) if !f.is_finite() => Some(prefix.to_owned()),
+            toml::Value::Table(t) => t
+                .iter()
+                .find_map(|(k, v)| walk(&if prefix.is_empty() { k.clone() } else { format!("{prefix}.{k}") }, v)),
+            toml::Value::Array(a) => a.iter().enumerate().find_map(|(i, v)| walk(&format!("{prefix}[{i}]"), v)),
+            _ => None,
+        }
+    }
+    walk("", &toml::Value::try_from(s).ok()?)
 }
 
 #[cfg(test)]
@@ -337,6 +363,9 @@ mod tests {
     fn builtins_load_and_stay_in_range() {
         for name in BUILTIN {
             let s = Scenario::load(name).unwrap();
+            assert_eq!(s.clutch.check_run(s.duration_s, s.control_hz), Ok(()), "{name}");
+            assert_eq!(s.clutch.check_physical(), Ok(()), "{name}");
+            assert!(non_finite(&s).is_none(), "{name}");
             for k in 0..2000 {
                 let t = k as f64 * s.duration_s / 2000.0;
                 let r = s.reference.at(t, s.duration_s);

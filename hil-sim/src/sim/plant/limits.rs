@@ -19,9 +19,16 @@ pub const MAX_CONTROL_STEPS: f64 = 1e6;
 /// reference clutch (20 kHz, 16 sub-steps).
 pub const MAX_PLANT_SUBSTEPS: f64 = 1e8;
 
+/// Absolute zero, °C: no temperature below it.
+pub const ABSOLUTE_ZERO_C: f64 = -273.15;
+/// Hottest ambient or initial temperature, °C (the fluid's carrier oil boils off well below).
+pub const MAX_TEMPERATURE_C: f64 = 500.0;
+/// Narrowest and widest fluid gap, m (MR clutches: 0.1–2 mm; 10 µm is already a bearing fit).
+pub const GAP_RANGE_M: (f64, f64) = (10e-6, 10e-3);
+
 /// A number over its limit (or not a number).
 #[derive(Clone, Debug, Error, PartialEq)]
-#[error("{field} = {value}: {limit}")]
+#[error("{field} = {}: {limit}", crate::numerics::shown(*value))]
 pub struct LimitError {
     pub field: &'static str,
     pub value: f64,
@@ -44,6 +51,25 @@ impl ClutchParams {
         let hz = self.coil.pwm_hz;
         if !(hz.is_finite() && hz > 0.0 && hz <= MAX_PWM_HZ) {
             return over("clutch.coil.pwm_hz", hz, format!("must be above 0 and at most {MAX_PWM_HZ} Hz"));
+        }
+        Ok(())
+    }
+
+    /// Physical ranges: temperatures above absolute zero (and below
+    /// [`MAX_TEMPERATURE_C`]), a gap within [`GAP_RANGE_M`].
+    pub fn check_physical(&self) -> Result<(), LimitError> {
+        for (field, v) in [("clutch.ambient_c", self.ambient_c), ("clutch.initial_c", self.initial_c)] {
+            if !(v > ABSOLUTE_ZERO_C && v <= MAX_TEMPERATURE_C) {
+                return over(
+                    field,
+                    v,
+                    format!("a temperature must lie above {ABSOLUTE_ZERO_C} °C and at most {MAX_TEMPERATURE_C} °C"),
+                );
+            }
+        }
+        let (lo, hi) = GAP_RANGE_M;
+        if !(self.fluid.gap >= lo && self.fluid.gap <= hi) {
+            return over("clutch.fluid.gap", self.fluid.gap, format!("the gap must lie within {lo:e} … {hi:e} m"));
         }
         Ok(())
     }
@@ -86,6 +112,13 @@ mod tests {
         let mut big = c.clone();
         big.magnetic.n_play = 100_000_000;
         assert_eq!(big.check_sizes().unwrap_err().field, "clutch.magnetic.n_play");
+        let mut cold = c.clone();
+        cold.initial_c = -300.0;
+        assert_eq!(cold.check_physical().unwrap_err().field, "clutch.initial_c");
+        let mut thin = c.clone();
+        thin.fluid.gap = 1e-300;
+        assert_eq!(thin.check_physical().unwrap_err().field, "clutch.fluid.gap");
+        assert_eq!(c.check_physical(), Ok(()));
         let mut big = c;
         big.pwm_substeps = 1 << 40;
         assert_eq!(big.check_sizes().unwrap_err().field, "clutch.pwm_substeps");
