@@ -164,3 +164,27 @@ fn simulate_refuses_unphysical_scenarios_and_writes_no_absurd_file() {
         assert!(!out.exists(), "{toml}: wrote {}", out.display());
     }
 }
+
+#[test]
+fn one_absurd_sample_is_a_spike_naming_its_line_and_the_fit_uses_the_rest() {
+    let d = scratch("absurd");
+    // Positions in the training part, the held-out part and the first row; absurd values
+    // of both signs.
+    for (k, (row, value)) in [(1499usize, "1e308"), (2500, "-1e308"), (0, "1e200"), (2999, "-3e250")].iter().enumerate() {
+        let rec = recording(&d, &format!("absurd{k}.csv"), |i, t, b, _| {
+            (i == *row).then(|| format!("{t:.4},{b:.6},{value}"))
+        });
+        let r = hil_sim(&["fit", rec.to_str().unwrap(), "--model", "algebraic", "--delay", "off", "--json"]);
+        assert_eq!(r.0, 0, "{}", r.2);
+        // The header is line 1: row i is on line i + 2.
+        assert!(r.2.contains(&format!("absurd{k}.csv:{}", row + 2)), "{}", r.2);
+        assert!(!r.2.contains("clipped"), "{}", r.2);
+        assert!(!r.1.contains("null") && !r.1.to_lowercase().contains("nan"), "{}", r.1);
+        let v: serde_json::Value = serde_json::from_str(&r.1).unwrap();
+        let fit = &v["results"][0];
+        for part in ["train", "heldout"] {
+            let rmse = fit[part]["rmse"].as_f64().unwrap();
+            assert!(rmse < 20.0, "{part} RMSE {rmse}: {}", r.1);
+        }
+    }
+}

@@ -43,6 +43,8 @@ pub struct Dataset {
     /// Samples the quality checks flagged: excluded from the fit (the model still runs
     /// through them) and scored separately.
     pub excluded: Vec<bool>,
+    /// Samples no score may include (gross outliers, [`crate::quality::Quality::unusable`]).
+    pub unusable: Vec<usize>,
     /// Given rate and acceleration of the input (e.g. [`crate::numerics::derivative::rates`]): fed to
     /// the models instead of the rate estimator's when present.
     pub rates: Option<(Vec<f64>, Vec<f64>)>,
@@ -66,7 +68,7 @@ impl Dataset {
             return Err(DatasetError::NoHeldOut);
         }
         let excluded = excluded.filter(|e| e.len() == n).unwrap_or_else(|| vec![false; n]);
-        let d = Self { dt, time, input, output, command, train_end, excluded, rates: None };
+        let d = Self { dt, time, input, output, command, train_end, excluded, unusable: Vec::new(), rates: None };
         let usable = d.train_rows().len();
         if usable < 20 {
             return Err(DatasetError::TooFewSamples(usable));
@@ -89,7 +91,12 @@ impl Dataset {
 
     /// Training samples that enter the fit.
     pub fn train_rows(&self) -> Vec<usize> {
-        (0..self.train_end).filter(|&i| !self.excluded.get(i).copied().unwrap_or(false)).collect()
+        (0..self.train_end).filter(|&i| !self.excluded.get(i).copied().unwrap_or(false) && self.usable(i)).collect()
+    }
+
+    /// Whether sample `i` may be scored at all (not a gross outlier).
+    pub fn usable(&self, i: usize) -> bool {
+        self.unusable.binary_search(&i).is_err()
     }
 
     /// Held-out samples the quality checks did not flag.
@@ -155,7 +162,8 @@ pub fn prepare_recording(
 ) -> Result<Prepared, DatasetError> {
     let quality = quality::check(&recording, ch)?;
     let excluded = (!keep_flagged).then(|| quality.excluded());
-    let data = Dataset::new(&recording, ch, train, excluded)
+    let mut data = Dataset::new(&recording, ch, train, excluded)
         .map_err(|e| DatasetError::In { path: recording.path.clone(), source: Box::new(e) })?;
+    data.unusable.clone_from(&quality.unusable);
     Ok(Prepared { recording, quality, data })
 }

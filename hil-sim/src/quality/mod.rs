@@ -15,7 +15,7 @@
 //! (often a step or on/off signal, legitimately flat at its extremes and with sharp
 //! edges) only the held-value check; the time column the sampling checks.
 //!
-//! One file per check: `clipped`, `standstill`, `dropout` (held values), `spike`,
+//! One file per check: `gross` (absurd single values, taken out before the others), `clipped`, `standstill`, `dropout` (held values), `spike`,
 //! `sampling` (time gaps and non-uniform intervals); `scale` measures a channel's scales,
 //! `config` holds the thresholds and `warning` the finding and how it names its place.
 
@@ -27,6 +27,7 @@ use crate::io::recording::{Recording, RecordingError};
 mod clipped;
 mod config;
 mod dropout;
+mod gross;
 mod sampling;
 mod scale;
 mod spike;
@@ -48,6 +49,9 @@ pub struct Quality {
     pub samples: usize,
     /// Samples inside some warning's range.
     pub excluded_samples: usize,
+    /// Gross outliers ([`gross`]): never scored, not even with the flagged samples.
+    #[serde(skip)]
+    pub unusable: Vec<usize>,
 }
 
 impl Quality {
@@ -78,6 +82,7 @@ pub fn check_with(rec: &Recording, ch: &Channels, cfg: &QualityConfig) -> Result
     let n = t.len();
     let ctx = Ctx { rec, t, dt: nominal_dt(t) };
     let mut found: Vec<Warning> = Vec::new();
+    let mut unusable = Vec::new();
     found.extend(sampling::sampling(&ctx, &ch.time, cfg));
     let mut signals: Vec<(&str, &[f64], bool)> = vec![(ch.input.as_str(), x, true), (ch.output.as_str(), y, true)];
     if let (Some(name), Some(u)) = (ch.command.as_deref(), u) {
@@ -86,6 +91,15 @@ pub fn check_with(rec: &Recording, ch: &Channels, cfg: &QualityConfig) -> Result
         }
     }
     for (name, v, full) in signals {
+        let cleaned = if full { gross::gross(&ctx, name, v) } else { None };
+        let v: &[f64] = match &cleaned {
+            Some((c, w)) => {
+                unusable.extend(w.iter().map(|w| w.first_index));
+                found.extend(w.iter().cloned());
+                c
+            }
+            None => v,
+        };
         let s = Scale::of(t, v);
         let mut major: Vec<Warning> = Vec::new();
         if full {
@@ -109,7 +123,9 @@ pub fn check_with(rec: &Recording, ch: &Channels, cfg: &QualityConfig) -> Result
         found.extend(minor);
     }
     found.sort_by(|a, b| a.start_s.total_cmp(&b.start_s).then_with(|| a.channel.cmp(&b.channel)));
-    let mut q = Quality { warnings: found, samples: n, excluded_samples: 0 };
+    unusable.sort_unstable();
+    unusable.dedup();
+    let mut q = Quality { warnings: found, samples: n, excluded_samples: 0, unusable };
     q.excluded_samples = q.excluded().iter().filter(|&&e| e).count();
     Ok(q)
 }

@@ -206,7 +206,17 @@ mod tests {
         let (lo, hi) = y.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
         let noise = 0.005 * (hi - lo);
         let output = y.iter().map(|v| v + noise * (rng.random::<f64>() - 0.5) * 12f64.sqrt()).collect();
-        Dataset { dt, time, input: x, output, command: None, train_end: 8400, excluded: vec![false; n], rates: None }
+        Dataset {
+            dt,
+            time,
+            input: x,
+            output,
+            command: None,
+            train_end: 8400,
+            excluded: vec![false; n],
+            unusable: Vec::new(),
+            rates: None,
+        }
     }
 
     fn run(data: &Dataset) -> Diagnosis {

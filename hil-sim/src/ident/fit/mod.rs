@@ -257,7 +257,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     let n = data.len();
     let (lo, hi) = crate::models::alignment::covered(n, &[delay, delay_u]);
     let unflagged: Vec<usize> = data.heldout_unflagged().into_iter().filter(|i| (lo..hi).contains(i)).collect();
-    let all_heldout: Vec<usize> = (data.train_end..n).filter(|i| (lo..hi).contains(i)).collect();
+    let all_heldout: Vec<usize> = (data.train_end..n).filter(|&i| (lo..hi).contains(&i) && data.usable(i)).collect();
     let rows: Vec<usize> = rows.into_iter().filter(|i| (lo..hi).contains(i)).collect();
     scored_parts(&rows, &all_heldout, (delay, delay_u), data.dt)?;
     let named = ParamsFile::from_flat(id, None, &p32).map(|f| f.params).unwrap_or(Values::Flat(params.clone()));
@@ -531,6 +531,7 @@ mod tests {
             command: u,
             train_end: 4200,
             excluded: vec![false; n],
+            unusable: Vec::new(),
             rates: None,
         }
     }
