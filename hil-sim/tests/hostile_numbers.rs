@@ -170,7 +170,8 @@ fn one_absurd_sample_is_a_spike_naming_its_line_and_the_fit_uses_the_rest() {
     let d = scratch("absurd");
     // Positions in the training part, the held-out part and the first row; absurd values
     // of both signs.
-    for (k, (row, value)) in [(1499usize, "1e308"), (2500, "-1e308"), (0, "1e200"), (2999, "-3e250")].iter().enumerate() {
+    for (k, (row, value)) in [(1499usize, "1e308"), (2500, "-1e308"), (0, "1e200"), (2999, "-3e250")].iter().enumerate()
+    {
         let rec = recording(&d, &format!("absurd{k}.csv"), |i, t, b, _| {
             (i == *row).then(|| format!("{t:.4},{b:.6},{value}"))
         });
@@ -187,4 +188,35 @@ fn one_absurd_sample_is_a_spike_naming_its_line_and_the_fit_uses_the_rest() {
             assert!(rmse < 20.0, "{part} RMSE {rmse}: {}", r.1);
         }
     }
+}
+
+#[test]
+fn timing_and_constant_channels_are_named_not_scored_silently() {
+    let d = scratch("timing");
+    // Whole milliseconds as the time column.
+    let ms = recording(&d, "ms.csv", |i, _, b, y| Some(format!("{i},{b:.6},{y:.5}")));
+    let ms = ms.to_str().unwrap();
+    let r = hil_sim(&["fit", ms, "--model", "algebraic"]);
+    refused(&r, &["ms.csv", "time column `t`", "milliseconds"]);
+    assert_eq!(r.2.matches("milliseconds").count(), 1, "said twice: {}", r.2);
+    let save = d.join("saved");
+    let rec = plain(&d);
+    let r = hil_sim(&["fit", rec.to_str().unwrap(), "--model", "algebraic", "--save", save.to_str().unwrap()]);
+    assert_eq!(r.0, 0, "{}", r.2);
+    let params = save.join("algebraic.json");
+    let r = hil_sim(&["replay", ms, "--params", params.to_str().unwrap()]);
+    refused(&r, &["ms.csv", "milliseconds"]);
+    // A constant input: nothing to identify.
+    let cin = recording(&d, "cin.csv", |_, t, _, y| Some(format!("{t:.4},0.3,{y:.5}")));
+    let r = hil_sim(&["fit", cin.to_str().unwrap(), "--model", "algebraic"]);
+    refused(&r, &["cin.csv", "input `b` is constant"]);
+    // A constant output: R² undefined, said so, never NaN.
+    let cout = recording(&d, "cout.csv", |_, t, b, _| Some(format!("{t:.4},{b:.6},5.0")));
+    let r = hil_sim(&["fit", cout.to_str().unwrap(), "--model", "algebraic"]);
+    assert_eq!(r.0, 0, "{}", r.2);
+    assert!(r.2.contains("output `torque` is constant"), "{}", r.2);
+    assert!(r.1.contains("undefined") && !r.1.contains("NaN"), "{}", r.1);
+    let r = hil_sim(&["replay", cout.to_str().unwrap(), "--params", params.to_str().unwrap()]);
+    assert!(r.2.contains("output `torque` is constant"), "{}", r.2);
+    assert!(r.1.contains("R² undefined") && !r.1.contains("NaN"), "{}", r.1);
 }

@@ -107,6 +107,9 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
     }
+    if let Some(w) = super::constant_output(&a.ch.output, &data.output) {
+        eprintln!("warning: {w}");
+    }
     for r in &run.results {
         for w in &r.warnings {
             eprintln!("warning: {}: {w}", r.model);
@@ -168,14 +171,14 @@ pub fn table(results: &[FitResult]) -> String {
     );
     for r in results {
         s += &format!(
-            "{:<16} {:>6} {:>10.4} {:>9.4} {:>8} {:>10.4} {:>9.4} {:>7.2}% {:>8.3} {:>9.1} {:>6.3}/{:<6.3}\n",
+            "{:<16} {:>6} {:>10.4} {:>9} {:>8} {:>10.4} {:>9} {:>7.2}% {:>8.3} {:>9.1} {:>6.3}/{:<6.3}\n",
             r.model,
             r.free_params,
             r.train.rmse,
-            r.train.r2,
+            super::fixed(r.train.r2, 4),
             format!("{:?}", r.method).to_lowercase(),
             r.heldout.rmse,
-            r.heldout.r2,
+            super::fixed(r.heldout.r2, 4),
             100.0 * r.heldout.r_rmse,
             r.fit_seconds,
             r.replay_ns_per_sample,

@@ -157,3 +157,21 @@ pub fn file_arg(p: &std::path::Path) -> anyhow::Result<PathBuf> {
         bail!("{}: no such file", p.display())
     }
 }
+
+/// `v` with `decimals` decimals, or `undefined` when it is not a number (e.g. R² of a
+/// constant output, which has no variance to explain).
+pub fn fixed(v: f64, decimals: usize) -> String {
+    if v.is_nan() {
+        "undefined".into()
+    } else {
+        format!("{v:.decimals$}")
+    }
+}
+
+/// The warning for a constant output channel (R² and GOF undefined), if it is one.
+pub fn constant_output(name: &str, y: &[f64]) -> Option<String> {
+    let v = y.first()?;
+    y.iter().all(|x| x == v).then(|| {
+        format!("the output `{name}` is constant ({v}): R² and GOF are undefined (there is no variance to explain)")
+    })
+}

@@ -39,6 +39,9 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
     }
+    if let Some(w) = super::constant_output(&a.ch.output, rec.channel(&a.ch.output)?) {
+        eprintln!("warning: {w}");
+    }
     let r = replay_recording(
         &rec,
         &a.ch.channels(),
@@ -68,11 +71,11 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
         r.model
     ));
     super::emit(&format!(
-        "  RMSE {:.4}  R-RMSE {:.2} %  R² {:.4}  GOF {:.4}  held samples {}\n",
+        "  RMSE {:.4}  R-RMSE {:.2} %  R² {}  GOF {}  held samples {}\n",
         m.rmse,
         100.0 * m.r_rmse,
-        m.r2,
-        m.gof,
+        super::fixed(m.r2, 4),
+        super::fixed(m.gof, 4),
         r.held
     ));
     Ok(())

@@ -19,14 +19,18 @@ use crate::quality::{self, Quality};
 pub enum DatasetError {
     #[error(transparent)]
     Recording(#[from] RecordingError),
+    #[error(transparent)]
+    TimeUnit(#[from] quality::timing::TimeUnitError),
+    #[error("the input `{channel}` is constant ({value}) over the whole recording: nothing to identify")]
+    ConstantInput { channel: String, value: f64 },
     #[error("training fraction {0}: must be strictly between 0 and 1")]
     TrainFraction(f64),
     #[error("the training part has only {0} usable samples (need at least 20)")]
     TooFewSamples(usize),
     #[error("the held-out part is empty (use a smaller training fraction)")]
     NoHeldOut,
-    #[error("{}: {source}", path.display())]
-    In { path: PathBuf, source: Box<DatasetError> },
+    #[error("{}: {inner}", path.display())]
+    In { path: PathBuf, inner: Box<DatasetError> },
 }
 
 /// The data a fit works on.
@@ -61,6 +65,10 @@ impl Dataset {
         let input = rec.channel(&ch.input)?.to_vec();
         let output = rec.channel(&ch.output)?.to_vec();
         let command = ch.command.as_deref().map(|c| rec.channel(c).map(<[f64]>::to_vec)).transpose()?;
+        quality::timing::check_time_unit(&ch.time, &time)?;
+        if let Some(v) = input.first().filter(|v| input.iter().all(|x| x == *v)) {
+            return Err(DatasetError::ConstantInput { channel: ch.input.clone(), value: *v });
+        }
         let dt = rec.mean_dt(&ch.time)?;
         let n = input.len();
         let train_end = ((n as f64) * train).round() as usize;
@@ -132,7 +140,7 @@ impl DatasetError {
     pub fn train_fraction(&self) -> Option<f64> {
         match self {
             Self::TrainFraction(v) => Some(*v),
-            Self::In { source, .. } => source.train_fraction(),
+            Self::In { inner, .. } => inner.train_fraction(),
             _ => None,
         }
     }
@@ -163,7 +171,7 @@ pub fn prepare_recording(
     let quality = quality::check(&recording, ch)?;
     let excluded = (!keep_flagged).then(|| quality.excluded());
     let mut data = Dataset::new(&recording, ch, train, excluded)
-        .map_err(|e| DatasetError::In { path: recording.path.clone(), source: Box::new(e) })?;
+        .map_err(|e| DatasetError::In { path: recording.path.clone(), inner: Box::new(e) })?;
     data.unusable.clone_from(&quality.unusable);
     Ok(Prepared { recording, quality, data })
 }

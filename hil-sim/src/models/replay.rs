@@ -41,6 +41,7 @@ pub fn replay_recording(
     let x = rec.channel(&ch.input)?;
     let y = rec.channel(&ch.output)?;
     let u = ch.command.as_deref().map(|c| rec.channel(c)).transpose()?;
+    crate::quality::timing::check_time_unit(&ch.time, t)?;
     let dt = rec.mean_dt(&ch.time)?;
     let (d, d_u) = (delays_s.0 / dt, if u.is_some() { delays_s.1 / dt } else { 0.0 });
     crate::models::alignment::check(x.len(), dt, &[d, d_u])?;
@@ -100,6 +101,8 @@ pub enum ReplayError {
     Recording(#[from] crate::io::recording::RecordingError),
     #[error("unknown model `{0}` (see `hil-sim models`)")]
     UnknownModel(String),
+    #[error(transparent)]
+    TimeUnit(#[from] crate::quality::timing::TimeUnitError),
     #[error(transparent)]
     Delay(#[from] crate::models::alignment::DelayError),
     #[error("{0}")]

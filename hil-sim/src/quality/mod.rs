@@ -32,6 +32,7 @@ mod sampling;
 mod scale;
 mod spike;
 mod standstill;
+pub mod timing;
 mod warning;
 
 pub use config::QualityConfig;
