@@ -42,7 +42,7 @@ fn scratch(name: &str) -> PathBuf {
 
 /// A 3 s recording at 1 kHz, `t,b,torque`, with `row` replacing the generated rows where it
 /// returns `Some`.
-fn recording(dir: &Path, name: &str, row: impl Fn(usize, f64, f64, f64) -> Option<String>) -> PathBuf {
+fn recording(dir: &Path, name: &str, mut row: impl FnMut(usize, f64, f64, f64) -> Option<String>) -> PathBuf {
     let mut s = String::from("t,b,torque\n");
     for i in 0..3000 {
         let t = i as f64 / 1000.0;
@@ -219,4 +219,26 @@ fn timing_and_constant_channels_are_named_not_scored_silently() {
     let r = hil_sim(&["replay", cout.to_str().unwrap(), "--params", params.to_str().unwrap()]);
     assert!(r.2.contains("output `torque` is constant"), "{}", r.2);
     assert!(r.1.contains("R² undefined") && !r.1.contains("NaN"), "{}", r.1);
+}
+
+#[test]
+fn a_jittered_sampling_clock_is_warned_about_and_rounded_stamps_are_not() {
+    let d = scratch("jitter");
+    // ±40 % jitter on every interval (a deterministic pseudo-random sequence).
+    let mut seed = 12345u64;
+    let mut t = 0.0;
+    let jit = recording(&d, "jit.csv", |_, _, b, y| {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        let u = (seed >> 11) as f64 / (1u64 << 53) as f64;
+        t += 1e-3 * (1.0 + 0.8 * (u - 0.5));
+        Some(format!("{t:.6},{b:.6},{y:.5}"))
+    });
+    let r = hil_sim(&["fit", jit.to_str().unwrap(), "--model", "algebraic"]);
+    assert_eq!(r.0, 0, "{}", r.2);
+    assert!(r.2.contains("non-uniform sampling"), "{}", r.2);
+    // Stamps rounded to 0.1 ms at 3 kHz (as in the Dyke files): on their grid, no warning.
+    let rounded = recording(&d, "rounded.csv", |i, _, b, y| Some(format!("{:.4},{b:.6},{y:.5}", i as f64 / 3000.0)));
+    let r = hil_sim(&["fit", rounded.to_str().unwrap(), "--model", "algebraic"]);
+    assert_eq!(r.0, 0, "{}", r.2);
+    assert!(!r.2.contains("non-uniform"), "{}", r.2);
 }

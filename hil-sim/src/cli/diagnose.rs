@@ -56,6 +56,9 @@ pub fn run_diagnosis(
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
     }
+    for n in &q.notes {
+        eprintln!("warning: {n}");
+    }
     let aux = rec.auxiliary_channels(ch);
     let bar = Bar::new(1, "diagnosing");
     let d = diagnose(&data, aux, ch.command.as_deref(), (&ch.input, &ch.output), opts, &bar);

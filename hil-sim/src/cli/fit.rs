@@ -107,6 +107,9 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
     }
+    for n in &q.notes {
+        eprintln!("warning: {n}");
+    }
     if let Some(w) = super::constant_output(&a.ch.output, &data.output) {
         eprintln!("warning: {w}");
     }
@@ -131,6 +134,7 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
             "train_samples": data.train_end,
             "heldout_samples": data.len() - data.train_end,
             "warnings": q.warnings,
+            "notes": q.notes,
             "excluded_samples": if a.ch.keep_flagged { 0 } else { q.excluded_samples },
             "results": run.results,
             "best": best,

@@ -39,6 +39,9 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
     }
+    for n in &q.notes {
+        eprintln!("warning: {n}");
+    }
     if let Some(w) = super::constant_output(&a.ch.output, rec.channel(&a.ch.output)?) {
         eprintln!("warning: {w}");
     }

@@ -50,6 +50,10 @@ pub struct Quality {
     pub samples: usize,
     /// Samples inside some warning's range.
     pub excluded_samples: usize,
+    /// Findings about the whole recording that exclude no sample (e.g. the sampling
+    /// clock's jitter): to be shown with the warnings.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub notes: Vec<String>,
     /// Gross outliers ([`gross`]): never scored, not even with the flagged samples.
     #[serde(skip)]
     pub unusable: Vec<usize>,
@@ -126,7 +130,8 @@ pub fn check_with(rec: &Recording, ch: &Channels, cfg: &QualityConfig) -> Result
     found.sort_by(|a, b| a.start_s.total_cmp(&b.start_s).then_with(|| a.channel.cmp(&b.channel)));
     unusable.sort_unstable();
     unusable.dedup();
-    let mut q = Quality { warnings: found, samples: n, excluded_samples: 0, unusable };
+    let notes = sampling::drift(&ctx, &ch.time, cfg).into_iter().collect();
+    let mut q = Quality { warnings: found, samples: n, excluded_samples: 0, notes, unusable };
     q.excluded_samples = q.excluded().iter().filter(|&&e| e).count();
     Ok(q)
 }

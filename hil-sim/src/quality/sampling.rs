@@ -45,3 +45,36 @@ pub(super) fn sampling(ctx: &Ctx, name: &str, cfg: &QualityConfig) -> Vec<Warnin
     }
     out
 }
+
+/// Stamps drifting off the uniform grid: the running sum of (interval / nominal − 1) over
+/// the intervals that are not gaps, i.e. how far a stamp sits from its grid point, in
+/// intervals. Rounding of the stamps (the Dyke files' 0.1 ms) stays under half an
+/// interval; jitter of the sampling clock walks away. `None` within one interval.
+pub(super) fn drift(ctx: &Ctx, name: &str, cfg: &QualityConfig) -> Option<String> {
+    let dt = ctx.dt;
+    if dt <= 0.0 {
+        return None;
+    }
+    let gap = 1.5f64.max(1.0 + cfg.dt_tolerance);
+    let (mut dev, mut worst, mut at) = (0.0f64, 0.0f64, 0usize);
+    for (i, w) in ctx.t.windows(2).enumerate() {
+        let r = (w[1] - w[0]) / dt;
+        if r < gap {
+            dev += r - 1.0;
+            if dev.abs() > worst {
+                (worst, at) = (dev.abs(), i + 1);
+            }
+        }
+    }
+    let (lo, hi) = min_max(&ctx.t.windows(2).map(|w| (w[1] - w[0]) / dt).collect::<Vec<_>>());
+    (worst > 1.0).then(|| {
+        format!(
+            "{name}: non-uniform sampling: intervals of {:.0}–{:.0} % of the nominal {:.3} ms, the stamps drift \
+             up to {worst:.1} intervals off a uniform grid (at {:.4} s); the models step at the nominal interval",
+            100.0 * lo,
+            100.0 * hi,
+            1e3 * dt,
+            ctx.t[at]
+        )
+    })
+}
