@@ -54,7 +54,7 @@ pub struct Quality {
     /// clock's jitter): to be shown with the warnings.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub notes: Vec<String>,
-    /// Gross outliers ([`gross`]): never scored, not even with the flagged samples.
+    /// Gross outliers (single samples 100× beyond the channel's range): never scored, not even with the flagged samples.
     #[serde(skip)]
     pub unusable: Vec<usize>,
 }
