@@ -83,7 +83,7 @@ pub fn run(a: DiagnoseArgs) -> anyhow::Result<()> {
     let (d, _) = run_diagnosis(&a.rec, &a.ch.channels(), a.ch.keep_flagged, &opts)?;
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        let mut rep = hil_sim::report::Report::new(format!("Diagnosis of {}", a.rec.display()));
+        let mut rep = hil_sim::report::Report::new(format!("Diagnosis of {}", hil_sim::report::file_label(&a.rec)));
         hil_sim::report::diagnose::section(&mut rep, dir, "diagnose", &d, (&a.ch.input, &a.ch.output))?;
         let index = rep.write(dir)?;
         eprintln!("report written to {}", index.display());

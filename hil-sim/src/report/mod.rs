@@ -115,6 +115,7 @@ impl Report {
         opts.insert(Options::ENABLE_TABLES);
         let mut events = Vec::new();
         let mut skip_image = false;
+        let mut skipped_links = 0usize;
         for ev in Parser::new_ext(&self.md, opts) {
             match ev {
                 Event::Start(Tag::Image { ref dest_url, .. }) => match inline_svg(dir, dest_url) {
@@ -126,6 +127,11 @@ impl Report {
                 },
                 Event::End(TagEnd::Image) if skip_image => skip_image = false,
                 _ if skip_image => {}
+                // Text is never markup: raw HTML in a title, cell or caption (a file name such
+                // as `<img onerror=…>.csv`) is shown as text, and links only go to the web.
+                Event::Html(s) | Event::InlineHtml(s) => events.push(Event::Text(s)),
+                Event::Start(Tag::Link { ref dest_url, .. }) if !safe_link(dest_url) => skipped_links += 1,
+                Event::End(TagEnd::Link) if skipped_links > 0 => skipped_links -= 1,
                 _ => events.push(ev),
             }
         }
@@ -171,6 +177,17 @@ fn inline_svg(dir: &Path, rel: &str) -> Option<String> {
     let text = std::fs::read_to_string(dir.join(p)).ok()?;
     let start = text.find("<svg")?;
     Some(text[start..].trim_end().to_owned())
+}
+
+/// How a report names a file: its name only, never the folders of the user's machine.
+pub fn file_label(path: &Path) -> String {
+    path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned())
+}
+
+/// A link the page may carry: to the web or relative (no `javascript:`, `data:`, …).
+fn safe_link(dest: &str) -> bool {
+    let d = dest.trim_start().to_ascii_lowercase();
+    d.starts_with("https://") || d.starts_with("http://") || !d.contains(':')
 }
 
 fn one_line(s: &str) -> String {
@@ -241,6 +258,17 @@ mod tests {
         let html = r.html(Path::new("/nonexistent"));
         assert!(html.contains("<img src=\"../secret.svg\""));
         assert!(html.contains("<img src=\"/etc/x.svg\""));
+    }
+
+    #[test]
+    fn raw_html_and_script_links_are_text() {
+        let mut r = Report::new("<script>x</script>");
+        r.paragraph("a <img src=x onerror=\"y\"> b [go](javascript:alert(1)) [ok](https://example.org)")
+            .table(&["<b>h</b>"], &[vec!["<svg onload=z>"]]);
+        let html = r.html(Path::new("/nonexistent"));
+        assert!(!html.contains("<script>") && !html.contains("<img") && !html.contains("<b>"));
+        assert!(!html.contains("<svg") && !html.contains("javascript:"));
+        assert!(html.contains("&lt;img src=x") && html.contains("<a href=\"https://example.org\">ok</a>"));
     }
 
     #[test]

@@ -1,0 +1,71 @@
+//! Issue 18: what the tool writes must be safe with hostile names and paths (the report's
+//! HTML, outputs that would overwrite inputs or follow planted symlinks).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn hil_sim(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_hil-sim")).args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hil-sim-hostile-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A short simulated recording at `path`.
+fn simulate(path: &Path) {
+    let (code, _, err) = hil_sim(&[
+        "simulate",
+        "--effect",
+        "field_lag",
+        "--base",
+        "algebraic",
+        "--excitation",
+        "noise",
+        "--duration",
+        "4",
+        "--fs",
+        "500",
+        "--out",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+}
+
+/// The text a browser shows for an HTML text node.
+fn unescape(s: &str) -> String {
+    s.replace("&lt;", "<").replace("&gt;", ">").replace("&quot;", "\"").replace("&amp;", "&")
+}
+
+const HOSTILE: &str = "<img src=x onerror=\"alert(1)\">.csv";
+
+/// Defect 5: a file name is shown as text in the report, never run as markup, and the
+/// report names no folder of the user's machine.
+#[test]
+fn hostile_file_name_is_text_in_the_report() {
+    let dir = tmp("inject");
+    let rec = dir.join(HOSTILE);
+    simulate(&rec);
+    for (cmd, extra) in [("fit", ["--model", "algebraic"]), ("diagnose", ["--model", "algebraic"])] {
+        let out = dir.join(format!("rep-{cmd}"));
+        let (code, _, err) = hil_sim(&[cmd, rec.to_str().unwrap(), extra[0], extra[1], "--out", out.to_str().unwrap()]);
+        assert_eq!(code, 0, "{cmd}: {err}");
+        let html = std::fs::read_to_string(out.join("index.html")).unwrap();
+        assert!(!html.contains("<img src=x"), "{cmd}: unescaped <img in the report");
+        let h1 = html.split("<h1>").nth(1).and_then(|s| s.split("</h1>").next()).unwrap();
+        assert!(!h1.contains('<') && !h1.contains('>'), "{cmd}: markup in the title: {h1}");
+        assert_eq!(unescape(h1), format!("{} of {HOSTILE}", if cmd == "fit" { "Fit" } else { "Diagnosis" }));
+        let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+        let folder = dir.to_str().unwrap();
+        assert!(!html.contains(folder) && !md.contains(folder), "{cmd}: absolute path in the report");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
