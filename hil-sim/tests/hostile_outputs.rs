@@ -40,6 +40,11 @@ fn simulate(path: &Path) {
     assert_eq!(code, 0, "{err}");
 }
 
+/// One error line (warnings may come before it).
+fn one_error(err: &str) -> bool {
+    err.lines().filter(|l| l.starts_with("error")).count() == 1
+}
+
 /// The text a browser shows for an HTML text node.
 fn unescape(s: &str) -> String {
     s.replace("&lt;", "<").replace("&gt;", ">").replace("&quot;", "\"").replace("&amp;", "&")
@@ -67,5 +72,68 @@ fn hostile_file_name_is_text_in_the_report() {
         let folder = dir.to_str().unwrap();
         assert!(!html.contains(folder) && !md.contains(folder), "{cmd}: absolute path in the report");
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Defect 9: no output overwrites an input, and a symlink planted in an output folder is
+/// refused instead of followed.
+#[test]
+fn outputs_never_overwrite_inputs_or_follow_symlinks() {
+    let dir = tmp("overwrite");
+    let rec = dir.join("rec.csv");
+    simulate(&rec);
+    let before = std::fs::read(&rec).unwrap();
+    let saved = dir.join("saved");
+    let (code, _, err) =
+        hil_sim(&["fit", rec.to_str().unwrap(), "--model", "algebraic", "--save", saved.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let params = saved.join("algebraic.json");
+    let params_before = std::fs::read(&params).unwrap();
+    // replay rec.csv --trace rec.csv (also by another spelling of the same file).
+    for trace in [rec.clone(), dir.join(".").join("rec.csv")] {
+        let (code, _, err) = hil_sim(&[
+            "replay",
+            rec.to_str().unwrap(),
+            "--params",
+            params.to_str().unwrap(),
+            "--trace",
+            trace.to_str().unwrap(),
+        ]);
+        assert_ne!(code, 0);
+        assert!(err.contains("is the input") && one_error(&err), "{err}");
+    }
+    assert_eq!(std::fs::read(&rec).unwrap(), before, "the recording was overwritten");
+    // export p.json --out p.json
+    let (code, _, err) = hil_sim(&["export", params.to_str().unwrap(), "--out", params.to_str().unwrap()]);
+    assert_ne!(code, 0);
+    assert!(err.contains("is the input") && one_error(&err), "{err}");
+    assert_eq!(std::fs::read(&params).unwrap(), params_before, "the parameters were overwritten");
+    // fit --out with a symlink planted in the output folder.
+    let out = dir.join("rep");
+    std::fs::create_dir_all(&out).unwrap();
+    let outside = dir.join("outside.txt");
+    std::fs::write(&outside, "keep").unwrap();
+    #[cfg(unix)]
+    {
+        std::os::unix::fs::symlink(&outside, out.join("index.html")).unwrap();
+        let (code, _, err) =
+            hil_sim(&["fit", rec.to_str().unwrap(), "--model", "algebraic", "--out", out.to_str().unwrap()]);
+        assert_ne!(code, 0);
+        assert!(err.contains("symbolic link") && one_error(&err), "{err}");
+        assert_eq!(std::fs::read_to_string(&outside).unwrap(), "keep", "written through the symlink");
+    }
+    // A plain output still works and leaves no temporary file behind.
+    let trace = dir.join("trace.csv");
+    let (code, _, err) = hil_sim(&[
+        "replay",
+        rec.to_str().unwrap(),
+        "--params",
+        params.to_str().unwrap(),
+        "--trace",
+        trace.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(std::fs::read_to_string(&trace).unwrap().starts_with("t,measured,model,residual\n"));
+    assert!(std::fs::read_dir(&dir).unwrap().all(|e| !e.unwrap().file_name().to_string_lossy().ends_with(".tmp")));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -24,11 +24,15 @@ use std::path::{Path, PathBuf};
 use pulldown_cmark::{html, CowStr, Event, Options, Parser, Tag, TagEnd};
 use thiserror::Error;
 
+use crate::io::output;
+
 /// Why a report was not written.
 #[derive(Debug, Error)]
 pub enum ReportError {
     #[error("writing {path}: {source}")]
     Io { path: PathBuf, source: std::io::Error },
+    #[error(transparent)]
+    Output(#[from] crate::io::output::OutputError),
 }
 
 /// A report under construction; see the module docs.
@@ -147,11 +151,10 @@ impl Report {
     /// path of `index.html`.
     pub fn write(&self, dir: impl AsRef<Path>) -> Result<PathBuf, ReportError> {
         let dir = dir.as_ref();
-        std::fs::create_dir_all(dir).map_err(|source| ReportError::Io { path: dir.into(), source })?;
-        let md = dir.join("report.md");
-        std::fs::write(&md, &self.md).map_err(|source| ReportError::Io { path: md, source })?;
+        output::create_dir(dir)?;
+        output::write(&dir.join("report.md"), &self.md)?;
         let index = dir.join("index.html");
-        std::fs::write(&index, self.html(dir)).map_err(|source| ReportError::Io { path: index.clone(), source })?;
+        output::write(&index, self.html(dir))?;
         Ok(index)
     }
 }

@@ -120,6 +120,7 @@ impl Recording {
     /// Read a recording, CSV or MAT-file: a file starting with a MAT-file header, or
     /// named `*.mat`, is read as a MAT-file; anything else as CSV.
     pub fn read(path: &Path) -> Result<Self, RecordingError> {
+        crate::io::output::note_input(path);
         let bytes = std::fs::read(path).map_err(|source| RecordingError::Io { path: path.to_path_buf(), source })?;
         Self::parse(path, &bytes)
     }
@@ -201,6 +202,7 @@ impl Recording {
 
     /// Read a CSV recording.
     pub fn read_csv(path: &Path) -> Result<Self, RecordingError> {
+        crate::io::output::note_input(path);
         let bytes = std::fs::read(path).map_err(|source| RecordingError::Io { path: path.to_path_buf(), source })?;
         Self::parse_csv(path, &bytes)
     }
