@@ -229,8 +229,9 @@ impl Recording {
                 reason: "the header row has no column names".into(),
             });
         }
-        for (i, n) in names.iter().enumerate() {
-            if !n.is_empty() && names[..i].contains(n) {
+        let mut seen = std::collections::HashSet::with_capacity(names.len());
+        for n in &names {
+            if !n.is_empty() && !seen.insert(n.as_str()) {
                 return Err(RecordingError::Malformed {
                     path: p(),
                     line: 1,
@@ -260,7 +261,8 @@ impl Recording {
             }
             for (i, col) in raw.iter_mut().enumerate() {
                 let text = rec.get(i).unwrap_or("");
-                let name = names.get(i).cloned().unwrap_or_default();
+                // The column's name is only looked at (and copied) for an error message.
+                let name = || names.get(i).map_or_else(String::new, |n| shown(n));
                 if text.is_empty() {
                     col.push(None);
                     continue;
@@ -268,11 +270,11 @@ impl Recording {
                 let v = parse_number(text).map_err(|_| RecordingError::NotANumber {
                     path: p(),
                     line,
-                    column: shown(&name),
+                    column: name(),
                     text: shown(text),
                 })?;
                 if !v.is_finite() {
-                    return Err(RecordingError::NonFinite { path: p(), line, column: shown(&name), text: shown(text) });
+                    return Err(RecordingError::NonFinite { path: p(), line, column: name(), text: shown(text) });
                 }
                 col.push(Some(v));
             }
