@@ -36,7 +36,7 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
         }
     }
     let control = config_page::default_control(a.control_hz)?;
-    let img = config_page::image(&file, &path, control)?;
+    let img = config_page::firmware_image(&file, &path, control)?;
     let bytes = img.encode();
     hil_sim::io::output::write(&a.out, bytes)?;
     let len = u16::from_le_bytes([bytes[6], bytes[7]]);

@@ -49,6 +49,8 @@ pub enum RecordingError {
     MatNonFinite { path: PathBuf, variable: String, sample: u64, value: f64 },
     #[error("{path}: sample {sample}: time {t} s does not increase (previous sample {prev} s)")]
     SampleTimeNotIncreasing { path: PathBuf, sample: u64, prev: f64, t: f64 },
+    #[error("{path}: column `{name}` is both the {first} and the {second}; they must be different channels")]
+    SameChannel { path: PathBuf, name: String, first: &'static str, second: &'static str },
 }
 
 /// What kind of file a recording came from: it decides whether a position is a file
@@ -333,6 +335,19 @@ impl Recording {
                 available: self.names().iter().map(|n| shown(n)).collect::<Vec<_>>().join(", "),
             }
         })
+    }
+
+    /// The channels `ch` names, checked to be different columns (an output that is also
+    /// the input or the time would be "predicted" perfectly).
+    pub fn check_roles(&self, ch: &Channels) -> Result<(), RecordingError> {
+        let mut roles = vec![("time", ch.time.as_str()), ("input", ch.input.as_str()), ("output", ch.output.as_str())];
+        roles.extend(ch.command.as_deref().map(|c| ("command", c)));
+        for (i, (first, a)) in roles.iter().enumerate() {
+            if let Some((second, _)) = roles[i + 1..].iter().find(|(_, b)| b == a) {
+                return Err(RecordingError::SameChannel { path: self.path.clone(), name: shown(a), first, second });
+            }
+        }
+        Ok(())
     }
 
     /// The time column `name`, checked to increase strictly.
