@@ -3,7 +3,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::Args;
 use hil_sim::ident::dataset::{prepare, Dataset, Prepared};
-use hil_sim::ident::diagnose::{diagnose, DiagnoseError, DiagnoseOptions, Diagnosis};
+use hil_sim::ident::diagnose::{diagnose, leak, DiagnoseError, DiagnoseOptions, Diagnosis};
 use hil_sim::io::recording::Channels;
 
 use super::progress::Bar;
@@ -56,7 +56,11 @@ pub fn run_diagnosis(
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
     }
-    let aux = rec.auxiliary_channels(ch);
+    let output = rec.channel(&ch.output)?;
+    let (aux, dropped) = leak::screen(rec.auxiliary_channels(ch), output, ch.command.as_deref());
+    for d in &dropped {
+        eprintln!("warning: {}: channel `{}` is not used by the diagnosis: {}", path.display(), d.name, d.reason);
+    }
     let bar = Bar::new(1, "diagnosing");
     let d = diagnose(&data, aux, ch.command.as_deref(), (&ch.input, &ch.output), opts, &bar);
     bar.finish();
