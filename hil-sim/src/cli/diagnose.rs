@@ -3,7 +3,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::Args;
 use hil_sim::ident::dataset::{prepare, Dataset, Prepared};
-use hil_sim::ident::diagnose::{diagnose, DiagnoseError, DiagnoseOptions, Diagnosis};
+use hil_sim::ident::diagnose::{diagnose, leak, DiagnoseError, DiagnoseOptions, Diagnosis};
 use hil_sim::io::recording::Channels;
 
 use super::progress::Bar;
@@ -59,7 +59,11 @@ pub fn run_diagnosis(
     for n in &q.notes {
         eprintln!("warning: {n}");
     }
-    let aux = rec.auxiliary_channels(ch);
+    let output = rec.channel(&ch.output)?;
+    let (aux, dropped) = leak::screen(rec.auxiliary_channels(ch), output, ch.command.as_deref());
+    for d in &dropped {
+        eprintln!("warning: {}: channel `{}` is not used by the diagnosis: {}", path.display(), d.name, d.reason);
+    }
     let bar = Bar::new(1, "diagnosing");
     let d = diagnose(&data, aux, ch.command.as_deref(), (&ch.input, &ch.output), opts, &bar);
     bar.finish();
@@ -86,7 +90,7 @@ pub fn run(a: DiagnoseArgs) -> anyhow::Result<()> {
     let (d, _) = run_diagnosis(&a.rec, &a.ch.channels(), a.ch.keep_flagged, &opts)?;
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        let mut rep = hil_sim::report::Report::new(format!("Diagnosis of {}", a.rec.display()));
+        let mut rep = hil_sim::report::Report::new(format!("Diagnosis of {}", hil_sim::report::file_label(&a.rec)));
         hil_sim::report::diagnose::section(&mut rep, dir, "diagnose", &d, (&a.ch.input, &a.ch.output))?;
         let index = rep.write(dir)?;
         eprintln!("report written to {}", index.display());

@@ -2,7 +2,6 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context;
 use clap::Args;
 use hil_sim::io::config_page;
 use hil_sim::io::params_file::ParamsFile;
@@ -37,9 +36,9 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
         }
     }
     let control = config_page::default_control(a.control_hz)?;
-    let img = config_page::image(&file, &path, control)?;
+    let img = config_page::firmware_image(&file, &path, control)?;
     let bytes = img.encode();
-    std::fs::write(&a.out, bytes).with_context(|| format!("writing {}", a.out.display()))?;
+    hil_sim::io::output::write(&a.out, bytes)?;
     let len = u16::from_le_bytes([bytes[6], bytes[7]]);
     let crc = u32::from_le_bytes([
         bytes[usize::from(len)],

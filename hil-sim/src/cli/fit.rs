@@ -119,7 +119,7 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
         }
     }
     if let Some(dir) = &a.out {
-        let title = format!("Fit of {}", path.display());
+        let title = format!("Fit of {}", hil_sim::report::file_label(path));
         let labels = Labels { input: a.ch.input.clone(), output: a.ch.output.clone() };
         let index = fit_page::write(dir, &title, data, &run.results, &labels)?;
         eprintln!("report written to {}", index.display());

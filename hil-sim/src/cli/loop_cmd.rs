@@ -60,9 +60,7 @@ pub struct LoopArgs {
 
 fn write_csv(dir: &Option<PathBuf>, name: &str, r: &Run) -> anyhow::Result<()> {
     if let Some(d) = dir {
-        std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
-        let p = d.join(name);
-        std::fs::write(&p, r.csv()).with_context(|| format!("writing {}", p.display()))?;
+        hil_sim::io::output::write(&d.join(name), r.csv())?;
     }
     Ok(())
 }

@@ -86,11 +86,12 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
 
 /// `t,measured,model,residual` with a header row.
 fn write_trace(path: &std::path::Path, r: &hil_sim::models::replay::ReplayReport) -> anyhow::Result<()> {
-    let mut w = csv::Writer::from_path(path)?;
-    w.write_record(["t", "measured", "model", "residual"])?;
-    for ((t, y), m) in r.time.iter().zip(&r.measured).zip(&r.model_output) {
-        w.write_record([t.to_string(), y.to_string(), m.to_string(), (y - m).to_string()])?;
-    }
-    w.flush()?;
-    Ok(())
+    Ok(hil_sim::io::output::write_with(path, |out| {
+        let mut w = csv::Writer::from_writer(out);
+        w.write_record(["t", "measured", "model", "residual"])?;
+        for ((t, y), m) in r.time.iter().zip(&r.measured).zip(&r.model_output) {
+            w.write_record([t.to_string(), y.to_string(), m.to_string(), (y - m).to_string()])?;
+        }
+        w.flush()
+    })?)
 }

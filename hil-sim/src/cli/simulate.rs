@@ -48,22 +48,15 @@ pub struct SimulateArgs {
 }
 
 fn write(path: &std::path::Path, text: &str) -> anyhow::Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+    Ok(hil_sim::io::output::write(path, text)?)
 }
 
 /// Create `path`'s folder and write `path` with `write`.
 fn write_with(
     path: &std::path::Path,
-    write: impl FnOnce(std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
+    write: impl FnOnce(&mut std::io::BufWriter<std::fs::File>) -> std::io::Result<()>,
 ) -> anyhow::Result<()> {
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    let file = std::fs::File::create(path).with_context(|| format!("writing {}", path.display()))?;
-    write(std::io::BufWriter::new(file)).with_context(|| format!("writing {}", path.display()))
+    Ok(hil_sim::io::output::write_with(path, write)?)
 }
 
 /// The generator's error with the flags that set the offending values.
@@ -135,11 +128,7 @@ pub fn run_cmd(a: SimulateArgs) -> anyhow::Result<()> {
     let rec = hil_sim::closed_loop::record::record(&sc).with_context(|| format!("simulating {name}"))?;
     pb.finish_and_clear();
     let (rows, r, k0) = (rec.recording.len(), &rec.run, rec.first);
-    if let Some(dir) = a.out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    }
-    let file = std::fs::File::create(&a.out).with_context(|| format!("writing {}", a.out.display()))?;
-    rec.recording.write_csv(std::io::BufWriter::new(file)).with_context(|| format!("writing {}", a.out.display()))?;
+    hil_sim::io::output::write_with(&a.out, |w| rec.recording.write_csv(w))?;
     let (tmin, tmax) = r.torque_true[k0..].iter().fold((f64::MAX, f64::MIN), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
     let theta_end = r.temperature.last().copied().unwrap_or(f64::NAN);
     if a.json {

@@ -61,6 +61,7 @@ impl Dataset {
         if !(train > 0.0 && train < 1.0) {
             return Err(DatasetError::TrainFraction(train));
         }
+        rec.check_roles(ch)?;
         let time = rec.time(&ch.time)?.to_vec();
         let input = rec.channel(&ch.input)?.to_vec();
         let output = rec.channel(&ch.output)?.to_vec();

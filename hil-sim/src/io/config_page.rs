@@ -28,7 +28,26 @@ pub enum PageBuildError {
     Page { path: PathBuf, source: PageError },
     #[error("default control settings at {control_hz} Hz: {source}")]
     Control { control_hz: f32, source: ParamError },
+    #[error("{}: model `{model}`: the firmware runs only {} (it refuses any other page)", path.display(), FIRMWARE_MODELS.join(", "))]
+    NotInFirmware { path: PathBuf, model: String },
+    #[error("{}: {model} parameters give a torque of {value:.3e} on a representative flux sweep (±{TRIAL_B} T); \
+             the firmware's f32 control step cannot use them", path.display())]
+    Absurd { path: PathBuf, model: String, value: f32 },
 }
+
+/// The models the firmware is built with (`firmware/src/controller.rs`, `Loop`): a page
+/// for any other model is refused there (`PageError::WrongModel`), so it is refused here.
+pub const FIRMWARE_MODELS: [&str; 4] = [
+    model_core::models::algebraic::Algebraic::ID,
+    model_core::models::bouc_wen::BoucWen::ID,
+    model_core::models::lugre::LuGre::ID,
+    model_core::models::tanh::Tanh::ID,
+];
+
+/// Peak flux density of the trial sweep, T.
+const TRIAL_B: f32 = 1.5;
+/// Largest torque (N·m) a parameter set may give on the trial sweep.
+const TRIAL_MAX: f32 = 1e6;
 
 /// The firmware's default control rate, Hz.
 pub const CONTROL_HZ: f32 = 20_000.0;
@@ -39,9 +58,27 @@ struct Check<'a> {
 }
 
 impl Visit for Check<'_> {
-    type Out = Result<(), model_core::ParamError>;
+    /// Validation, then the largest |output| (or a non-finite one) on the trial sweep.
+    type Out = Result<f32, model_core::ParamError>;
     fn visit<M: Model>(self) -> Self::Out {
-        M::from_params(self.params, self.dt).map(|_| ())
+        let m = M::from_params(self.params, self.dt)?;
+        // Two periods of a 5 Hz sine of ±TRIAL_B T, and its rate, at the page's time step.
+        let w = 2.0 * core::f32::consts::PI * 5.0;
+        let n = ((0.4 / self.dt) as usize).clamp(100, 20_000);
+        let kin = |k: usize| {
+            let t = k as f32 * 0.4 / n as f32;
+            model_core::Kin::new(TRIAL_B * (w * t).sin(), TRIAL_B * w * (w * t).cos(), 0.0, 0.0)
+        };
+        let mut s = m.initial_state(&kin(0));
+        let mut worst = 0.0f32;
+        for k in 0..n {
+            let y = m.step(&mut s, &kin(k));
+            if !y.is_finite() || !model_core::Finite::is_finite(&s) {
+                return Ok(f32::NAN);
+            }
+            worst = worst.max(y.abs());
+        }
+        Ok(worst)
     }
 }
 
@@ -52,15 +89,27 @@ pub fn image(file: &ParamsFile, path: &Path, control: ValidatedConfig) -> Result
     let flat = file.flat(path)?;
     let dt = control.get().dt;
     let (p, model) = (|| path.to_owned(), || file.model.clone());
-    visit(&file.model, Check { params: &flat, dt })
+    let worst = visit(&file.model, Check { params: &flat, dt })
         .ok_or_else(|| PageBuildError::UnknownModel { path: p(), model: model() })?
         .map_err(|source| PageBuildError::Params { path: p(), model: model(), dt, source })?;
+    if worst.is_nan() || worst > TRIAL_MAX {
+        return Err(PageBuildError::Absurd { path: p(), model: model(), value: worst });
+    }
     let rate = match &file.rate {
         Some(r) => crate::io::rate::parse(r).map_err(|source| PageBuildError::RateText { path: p(), source })?,
         None => RateSpec::Backward,
     };
     rate.build(dt).map_err(|source| PageBuildError::Rate { path: p(), rate, dt, source })?;
     ConfigImage::new(&file.model, &flat, rate, control).map_err(|source| PageBuildError::Page { path: p(), source })
+}
+
+/// The page for `file` as [`image`] makes it, refused unless the firmware is built with
+/// its model ([`FIRMWARE_MODELS`]): what `export` writes.
+pub fn firmware_image(file: &ParamsFile, path: &Path, control: ValidatedConfig) -> Result<ConfigImage, PageBuildError> {
+    if !FIRMWARE_MODELS.contains(&file.model.as_str()) {
+        return Err(PageBuildError::NotInFirmware { path: path.to_owned(), model: file.model.clone() });
+    }
+    image(file, path, control)
 }
 
 /// Control settings at `control_hz` from the defaults (`ControlConfig::defaults`).

@@ -72,6 +72,7 @@ pub fn block(name: &str) -> (&str, usize) {
 
 impl ParamsFile {
     pub fn read(path: &Path) -> Result<Self, ParamsFileError> {
+        crate::io::output::note_input(path);
         let text =
             std::fs::read_to_string(path).map_err(|source| ParamsFileError::Io { path: path.to_path_buf(), source })?;
         serde_json::from_str(&text).map_err(|source| ParamsFileError::Json { path: path.to_path_buf(), source })

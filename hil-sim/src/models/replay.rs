@@ -37,6 +37,7 @@ pub fn replay_recording(
     rate: RateSpec,
     delays_s: (f64, f64),
 ) -> Result<ReplayReport, ReplayError> {
+    rec.check_roles(ch)?;
     let t = rec.time(&ch.time)?;
     let x = rec.channel(&ch.input)?;
     let y = rec.channel(&ch.output)?;

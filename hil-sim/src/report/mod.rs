@@ -24,11 +24,15 @@ use std::path::{Path, PathBuf};
 use pulldown_cmark::{html, CowStr, Event, Options, Parser, Tag, TagEnd};
 use thiserror::Error;
 
+use crate::io::output;
+
 /// Why a report was not written.
 #[derive(Debug, Error)]
 pub enum ReportError {
     #[error("writing {path}: {source}")]
     Io { path: PathBuf, source: std::io::Error },
+    #[error(transparent)]
+    Output(#[from] crate::io::output::OutputError),
 }
 
 /// A report under construction; see the module docs.
@@ -115,6 +119,7 @@ impl Report {
         opts.insert(Options::ENABLE_TABLES);
         let mut events = Vec::new();
         let mut skip_image = false;
+        let mut skipped_links = 0usize;
         for ev in Parser::new_ext(&self.md, opts) {
             match ev {
                 Event::Start(Tag::Image { ref dest_url, .. }) => match inline_svg(dir, dest_url) {
@@ -126,6 +131,11 @@ impl Report {
                 },
                 Event::End(TagEnd::Image) if skip_image => skip_image = false,
                 _ if skip_image => {}
+                // Text is never markup: raw HTML in a title, cell or caption (a file name such
+                // as `<img onerror=…>.csv`) is shown as text, and links only go to the web.
+                Event::Html(s) | Event::InlineHtml(s) => events.push(Event::Text(s)),
+                Event::Start(Tag::Link { ref dest_url, .. }) if !safe_link(dest_url) => skipped_links += 1,
+                Event::End(TagEnd::Link) if skipped_links > 0 => skipped_links -= 1,
                 _ => events.push(ev),
             }
         }
@@ -141,11 +151,10 @@ impl Report {
     /// path of `index.html`.
     pub fn write(&self, dir: impl AsRef<Path>) -> Result<PathBuf, ReportError> {
         let dir = dir.as_ref();
-        std::fs::create_dir_all(dir).map_err(|source| ReportError::Io { path: dir.into(), source })?;
-        let md = dir.join("report.md");
-        std::fs::write(&md, &self.md).map_err(|source| ReportError::Io { path: md, source })?;
+        output::create_dir(dir)?;
+        output::write(&dir.join("report.md"), &self.md)?;
         let index = dir.join("index.html");
-        std::fs::write(&index, self.html(dir)).map_err(|source| ReportError::Io { path: index.clone(), source })?;
+        output::write(&index, self.html(dir))?;
         Ok(index)
     }
 }
@@ -171,6 +180,17 @@ fn inline_svg(dir: &Path, rel: &str) -> Option<String> {
     let text = std::fs::read_to_string(dir.join(p)).ok()?;
     let start = text.find("<svg")?;
     Some(text[start..].trim_end().to_owned())
+}
+
+/// How a report names a file: its name only, never the folders of the user's machine.
+pub fn file_label(path: &Path) -> String {
+    path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned())
+}
+
+/// A link the page may carry: to the web or relative (no `javascript:`, `data:`, …).
+fn safe_link(dest: &str) -> bool {
+    let d = dest.trim_start().to_ascii_lowercase();
+    d.starts_with("https://") || d.starts_with("http://") || !d.contains(':')
 }
 
 fn one_line(s: &str) -> String {
@@ -241,6 +261,17 @@ mod tests {
         let html = r.html(Path::new("/nonexistent"));
         assert!(html.contains("<img src=\"../secret.svg\""));
         assert!(html.contains("<img src=\"/etc/x.svg\""));
+    }
+
+    #[test]
+    fn raw_html_and_script_links_are_text() {
+        let mut r = Report::new("<script>x</script>");
+        r.paragraph("a <img src=x onerror=\"y\"> b [go](javascript:alert(1)) [ok](https://example.org)")
+            .table(&["<b>h</b>"], &[vec!["<svg onload=z>"]]);
+        let html = r.html(Path::new("/nonexistent"));
+        assert!(!html.contains("<script>") && !html.contains("<img") && !html.contains("<b>"));
+        assert!(!html.contains("<svg") && !html.contains("javascript:"));
+        assert!(html.contains("&lt;img src=x") && html.contains("<a href=\"https://example.org\">ok</a>"));
     }
 
     #[test]

@@ -31,6 +31,7 @@ pub mod base;
 pub mod candidates;
 pub mod describe;
 pub mod diagnosis;
+pub mod leak;
 pub mod locate;
 pub mod options;
 pub mod profile;

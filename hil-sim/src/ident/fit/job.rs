@@ -93,7 +93,7 @@ pub fn run(job: &FitJob, progress: &dyn Progress) -> Result<FitRun, FitJobError>
 /// Write each result as `<dir>/<model>.json`, a `replay --params` file naming its source.
 pub fn save(dir: &Path, results: &[FitResult], recording: &Path) -> Result<Vec<PathBuf>, FitJobError> {
     let err = |path: &Path, reason: String| FitJobError::Save { path: path.to_owned(), reason };
-    std::fs::create_dir_all(dir).map_err(|e| err(dir, format!("cannot create: {e}")))?;
+    crate::io::output::create_dir(dir).map_err(|e| err(dir, e.to_string()))?;
     let mut written = Vec::with_capacity(results.len());
     for r in results {
         let file = dir.join(format!("{}.json", r.model));
@@ -104,7 +104,7 @@ pub fn save(dir: &Path, results: &[FitResult], recording: &Path) -> Result<Vec<P
         pf.delay_s = (r.delay_s != 0.0).then_some(r.delay_s);
         pf.command_delay_s = (r.command_delay_s != 0.0).then_some(r.command_delay_s);
         let text = serde_json::to_string_pretty(&pf).map_err(|e| err(&file, e.to_string()))? + "\n";
-        std::fs::write(&file, text).map_err(|e| err(&file, format!("cannot write: {e}")))?;
+        crate::io::output::write(&file, text).map_err(|e| err(&file, e.to_string()))?;
         written.push(file);
     }
     Ok(written)

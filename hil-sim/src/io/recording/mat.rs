@@ -12,8 +12,11 @@ use std::path::Path;
 
 use super::{Column, Format, Recording, RecordingError};
 
-/// Largest size a compressed element may inflate to (bytes).
-const MAX_INFLATED: u64 = 1 << 30;
+/// What reading a MAT-file may hold in memory beyond the file itself (bytes): 64 MiB and
+/// four times the file's size, for the inflated elements and the values read as f64.
+fn memory_budget(file_len: usize) -> u64 {
+    (64 << 20) + 4 * file_len as u64
+}
 
 const MI_INT8: u32 = 1;
 const MI_UINT8: u32 = 2;
@@ -198,7 +201,9 @@ fn numbers(t: u32, data: &[u8], e: Endian, at: usize) -> R<Vec<f64>> {
 }
 
 /// The payload of an miMATRIX element.
-fn matrix(data: &[u8], base: usize, e: Endian) -> R<Variable> {
+/// `left`: the memory budget left; the values' declared size (as f64) is charged to it
+/// before they are read.
+fn matrix(data: &[u8], base: usize, e: Endian, left: &mut u64) -> R<Variable> {
     let mut c = Cursor { buf: data, pos: 0, base, e };
     let (t, flags, at) = c.element()?;
     if t != MI_UINT32 || flags.len() != 8 {
@@ -230,6 +235,7 @@ fn matrix(data: &[u8], base: usize, e: Endian) -> R<Variable> {
     let kind = match class {
         6..=15 if complex => Kind::Complex,
         6..=15 => {
+            charge(&name, &dims, left, base)?;
             let (t, re, at) = c.element()?;
             Kind::Numeric(numbers(t, re, e, at)?)
         }
@@ -238,15 +244,48 @@ fn matrix(data: &[u8], base: usize, e: Endian) -> R<Variable> {
     Ok(Variable { name, dims, kind })
 }
 
-fn inflate(data: &[u8], at: usize) -> R<Vec<u8>> {
-    let mut out = Vec::new();
-    let mut z = flate2::read::ZlibDecoder::new(data).take(MAX_INFLATED + 1);
-    z.read_to_end(&mut out)
-        .map_err(|err| Fault::Format(format!("compressed element at byte {at} does not inflate: {err}")))?;
-    if out.len() as u64 > MAX_INFLATED {
-        return Err(Fault::Format(format!("compressed element at byte {at} inflates to more than 1 GiB")));
+/// Inflate the array a compressed element holds: its tag (the first 8 bytes) declares the
+/// array's size, which is checked against `budget` before the rest is inflated, and no more
+/// than the declared size is ever inflated.
+fn inflate(data: &[u8], at: usize, e: Endian, budget: u64) -> R<Vec<u8>> {
+    let broken =
+        |err: std::io::Error| Fault::Format(format!("compressed element at byte {at} does not inflate: {err}"));
+    let mut z = flate2::read::ZlibDecoder::new(data);
+    let mut tag = [0u8; 8];
+    z.read_exact(&mut tag).map_err(broken)?;
+    let t = e.u32([tag[0], tag[1], tag[2], tag[3]]);
+    if t != MI_MATRIX {
+        return Err(Fault::Format(format!("compressed element at byte {at} holds {}, not a matrix", type_name(t))));
     }
+    let declared = u64::from(e.u32([tag[4], tag[5], tag[6], tag[7]]));
+    if declared > budget {
+        return Err(Fault::Format(format!(
+            "compressed element at byte {at} declares an array of {declared} bytes, more than the {budget} bytes \
+             allowed for this file (64 MiB + 4 × its size)"
+        )));
+    }
+    let mut out = tag.to_vec();
+    out.reserve(declared as usize);
+    z.take(declared).read_to_end(&mut out).map_err(broken)?;
     Ok(out)
+}
+
+/// Charge an array's values (as f64) to the reading budget.
+fn charge(name: &str, dims: &[u64], left: &mut u64, at: usize) -> R<()> {
+    let count = dims.iter().try_fold(1u64, |a, &d| a.checked_mul(d));
+    let bytes = count.and_then(|c| c.checked_mul(8));
+    match bytes {
+        Some(b) if b <= *left => {
+            *left -= b;
+            Ok(())
+        }
+        _ => Err(Fault::Format(format!(
+            "array `{}` at byte {at} declares {} values, more than this file may hold in memory \
+             (64 MiB + 4 × its size)",
+            name,
+            shape(dims)
+        ))),
+    }
 }
 
 /// Every variable in the file, in file order.
@@ -269,23 +308,21 @@ fn variables(bytes: &[u8]) -> R<Vec<Variable>> {
     if version != 0x0100 {
         return Err(Fault::Format(format!("header version {version:#06x}, expected 0x0100")));
     }
+    let budget = memory_budget(bytes.len());
+    let mut left = budget;
     let mut out = Vec::new();
     let mut body = Cursor { buf: &bytes[128..], pos: 0, base: 128, e };
     while !body.at_end() {
         let (t, data, at) = body.element()?;
         match t {
-            MI_MATRIX => out.push(matrix(data, at + 8, e)?),
+            MI_MATRIX => {
+                out.push(matrix(data, at + 8, e, &mut left)?);
+            }
             MI_COMPRESSED => {
-                let inner = inflate(data, at)?;
+                let inner = inflate(data, at, e, budget)?;
                 let mut c = Cursor { buf: &inner, pos: 0, base: at + 8, e };
-                let (t, data, _) = c.element()?;
-                if t != MI_MATRIX {
-                    return Err(Fault::Format(format!(
-                        "compressed element at byte {at} holds {}, not a matrix",
-                        type_name(t)
-                    )));
-                }
-                out.push(matrix(data, at + 8, e)?);
+                let (_, data, _) = c.element()?;
+                out.push(matrix(data, at + 8, e, &mut left)?);
             }
             other => {
                 return Err(Fault::Format(format!(

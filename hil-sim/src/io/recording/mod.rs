@@ -49,6 +49,8 @@ pub enum RecordingError {
     MatNonFinite { path: PathBuf, variable: String, sample: u64, value: f64 },
     #[error("{path}: sample {sample}: time {t} s does not increase (previous sample {prev} s)")]
     SampleTimeNotIncreasing { path: PathBuf, sample: u64, prev: f64, t: f64 },
+    #[error("{path}: column `{name}` is both the {first} and the {second}; they must be different channels")]
+    SameChannel { path: PathBuf, name: String, first: &'static str, second: &'static str },
 }
 
 /// What kind of file a recording came from: it decides whether a position is a file
@@ -120,6 +122,7 @@ impl Recording {
     /// Read a recording, CSV or MAT-file: a file starting with a MAT-file header, or
     /// named `*.mat`, is read as a MAT-file; anything else as CSV.
     pub fn read(path: &Path) -> Result<Self, RecordingError> {
+        crate::io::output::note_input(path);
         let bytes = std::fs::read(path).map_err(|source| RecordingError::Io { path: path.to_path_buf(), source })?;
         Self::parse(path, &bytes)
     }
@@ -201,6 +204,7 @@ impl Recording {
 
     /// Read a CSV recording.
     pub fn read_csv(path: &Path) -> Result<Self, RecordingError> {
+        crate::io::output::note_input(path);
         let bytes = std::fs::read(path).map_err(|source| RecordingError::Io { path: path.to_path_buf(), source })?;
         Self::parse_csv(path, &bytes)
     }
@@ -227,8 +231,9 @@ impl Recording {
                 reason: "the header row has no column names".into(),
             });
         }
-        for (i, n) in names.iter().enumerate() {
-            if !n.is_empty() && names[..i].contains(n) {
+        let mut seen = std::collections::HashSet::with_capacity(names.len());
+        for n in &names {
+            if !n.is_empty() && !seen.insert(n.as_str()) {
                 return Err(RecordingError::Malformed {
                     path: p(),
                     line: 1,
@@ -258,7 +263,8 @@ impl Recording {
             }
             for (i, col) in raw.iter_mut().enumerate() {
                 let text = rec.get(i).unwrap_or("");
-                let name = names.get(i).cloned().unwrap_or_default();
+                // The column's name is only looked at (and copied) for an error message.
+                let name = || names.get(i).map_or_else(String::new, |n| shown(n));
                 if text.is_empty() {
                     col.push(None);
                     continue;
@@ -266,11 +272,11 @@ impl Recording {
                 let v = parse_number(text).map_err(|_| RecordingError::NotANumber {
                     path: p(),
                     line,
-                    column: shown(&name),
+                    column: name(),
                     text: shown(text),
                 })?;
                 if !v.is_finite() {
-                    return Err(RecordingError::NonFinite { path: p(), line, column: shown(&name), text: shown(text) });
+                    return Err(RecordingError::NonFinite { path: p(), line, column: name(), text: shown(text) });
                 }
                 col.push(Some(v));
             }
@@ -329,6 +335,19 @@ impl Recording {
                 available: self.names().iter().map(|n| shown(n)).collect::<Vec<_>>().join(", "),
             }
         })
+    }
+
+    /// The channels `ch` names, checked to be different columns (an output that is also
+    /// the input or the time would be "predicted" perfectly).
+    pub fn check_roles(&self, ch: &Channels) -> Result<(), RecordingError> {
+        let mut roles = vec![("time", ch.time.as_str()), ("input", ch.input.as_str()), ("output", ch.output.as_str())];
+        roles.extend(ch.command.as_deref().map(|c| ("command", c)));
+        for (i, (first, a)) in roles.iter().enumerate() {
+            if let Some((second, _)) = roles[i + 1..].iter().find(|(_, b)| b == a) {
+                return Err(RecordingError::SameChannel { path: self.path.clone(), name: shown(a), first, second });
+            }
+        }
+        Ok(())
     }
 
     /// The time column `name`, checked to increase strictly.

@@ -28,10 +28,7 @@ where
         draw(&root).map_err(|msg| PlotError::Draw { path: path.into(), msg })?;
         root.present().map_err(|e| PlotError::Draw { path: path.into(), msg: e.to_string() })?;
     }
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|source| PlotError::Io { path: dir.into(), source })?;
-    }
-    std::fs::write(path, svg).map_err(|source| PlotError::Io { path: path.into(), source })
+    Ok(crate::io::output::write(path, svg)?)
 }
 
 pub(super) fn chart<'a, 'b>(

@@ -54,6 +54,8 @@ pub enum PlotError {
     NoFiniteData { what: String },
     #[error("drawing {path}: {msg}")]
     Draw { path: PathBuf, msg: String },
+    #[error(transparent)]
+    Output(#[from] crate::io::output::OutputError),
     #[error("writing {path}: {source}")]
     Io { path: PathBuf, source: std::io::Error },
 }

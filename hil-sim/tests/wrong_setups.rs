@@ -1,0 +1,91 @@
+//! Issue 18, defect 8 (part): set-ups that cannot be right are refused with the reason:
+//! an export for a model the firmware is not built with, absurd parameter values, and the
+//! same channel as input and output.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn hil_sim(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_hil-sim")).args(args).output().unwrap();
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("hil-sim-setups-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn one_error(err: &str) -> bool {
+    err.lines().filter(|l| l.starts_with("error")).count() == 1
+}
+
+fn bouc_wen(alpha: f32) -> String {
+    let mut p = model_core::models::bouc_wen::SEED000_AVERAGE;
+    p[0] = alpha;
+    format!("{{\"model\":\"bouc_wen\",\"params\":{}}}", serde_json::to_string(&p.to_vec()).unwrap())
+}
+
+#[test]
+fn export_refuses_what_the_firmware_cannot_run() {
+    let dir = tmp("export");
+    let out = dir.join("page.bin");
+    let out = out.to_str().unwrap();
+    // A model the firmware is not built with (its `Loop` holds algebraic, bouc_wen, lugre, tanh).
+    let spencer = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/spencer_dyke_1997.json");
+    let (code, _, err) = hil_sim(&["export", spencer.to_str().unwrap(), "--out", out]);
+    assert_ne!(code, 0);
+    assert!(err.contains("`spencer`") && err.contains("firmware runs only") && one_error(&err), "{err}");
+    assert!(!Path::new(out).exists(), "a page was written");
+    // α = 1e38: validated, but the output overflows f32 on a representative sweep.
+    let p = dir.join("bw.json");
+    std::fs::write(&p, bouc_wen(1e38)).unwrap();
+    let (code, _, err) = hil_sim(&["export", p.to_str().unwrap(), "--out", out]);
+    assert_ne!(code, 0);
+    assert!(err.contains("bw.json") && err.contains("bouc_wen") && one_error(&err), "{err}");
+    assert!(!Path::new(out).exists(), "a page was written");
+    // The published set exports.
+    std::fs::write(&p, bouc_wen(model_core::models::bouc_wen::SEED000_AVERAGE[0])).unwrap();
+    let (code, _, err) = hil_sim(&["export", p.to_str().unwrap(), "--out", out]);
+    assert_eq!(code, 0, "{err}");
+    assert!(Path::new(out).exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_output_cannot_be_the_input() {
+    let dir = tmp("channels");
+    let rec = dir.join("rec.csv");
+    let (code, _, err) = hil_sim(&[
+        "simulate",
+        "--effect",
+        "field_lag",
+        "--base",
+        "algebraic",
+        "--excitation",
+        "noise",
+        "--duration",
+        "4",
+        "--fs",
+        "500",
+        "--out",
+        rec.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let rec = rec.to_str().unwrap();
+    for args in [
+        vec!["fit", rec, "--model", "algebraic", "--input", "torque", "--output", "torque"],
+        vec!["fit", rec, "--model", "algebraic", "--output", "t"],
+        vec!["diagnose", rec, "--model", "algebraic", "--input", "torque"],
+    ] {
+        let (code, out, err) = hil_sim(&args);
+        assert_ne!(code, 0, "{args:?}: {out}");
+        assert!(err.contains("must be different channels") && one_error(&err), "{args:?}: {err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
