@@ -1,15 +1,7 @@
 //! The command-line contract (shared/spec/cli-contract.md), exercised on the binary.
 
-use std::process::Command;
-
-fn hil_sim(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_hil-sim")).args(args).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::hil_sim;
 
 #[test]
 fn models_json_lists_all_17_with_contract_fields() {

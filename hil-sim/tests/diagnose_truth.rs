@@ -1,16 +1,8 @@
 //! Issue 18, defect 10: a simulated recording carries `torque_true`; the diagnosis must not
 //! "find" that the torque depends on its own truth or on a copy of the output.
 
-use std::process::Command;
-
-fn hil_sim(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_hil-sim")).args(args).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::hil_sim;
 
 #[test]
 fn diagnose_leaves_out_the_truth_and_copies_of_the_output() {

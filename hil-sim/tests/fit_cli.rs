@@ -1,15 +1,7 @@
 //! `hil-sim fit` and `hil-sim compare` on real and simulated recordings, through the binary.
 
-use std::process::Command;
-
-fn hil_sim(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_hil-sim")).args(args).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
+mod common;
+use common::hil_sim;
 
 fn dyke(name: &str) -> String {
     hil_sim::io::bundled::data_file(&format!("dyke/{name}")).unwrap().display().to_string()

@@ -3,41 +3,15 @@
 //! sample, a hang, or a file with NaN in it. Inputs are generated here.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+
+mod common;
+use common::{hil_sim_within, scratch};
 
 /// Longest any of these runs may take, s: each is refused from its numbers, before work.
 const DEADLINE_S: u64 = 60;
 
 fn hil_sim(args: &[&str]) -> (i32, String, String) {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_hil-sim"))
-        .args(args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    while child.try_wait().unwrap().is_none() {
-        if start.elapsed() > Duration::from_secs(DEADLINE_S) {
-            child.kill().unwrap();
-            panic!("hil-sim {args:?} still running after {DEADLINE_S} s");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let out = child.wait_with_output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-/// A fresh scratch folder for one test.
-fn scratch(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hil-sim-hostile-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    hil_sim_within(args, DEADLINE_S)
 }
 
 /// A 3 s recording at 1 kHz, `t,b,torque`, with `row` replacing the generated rows where it

@@ -1,44 +1,8 @@
 //! Issue 18: what the tool writes must be safe with hostile names and paths (the report's
 //! HTML, outputs that would overwrite inputs or follow planted symlinks).
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn hil_sim(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_hil-sim")).args(args).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hil-sim-hostile-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// A short simulated recording at `path`.
-fn simulate(path: &Path) {
-    let (code, _, err) = hil_sim(&[
-        "simulate",
-        "--effect",
-        "field_lag",
-        "--base",
-        "algebraic",
-        "--excitation",
-        "noise",
-        "--duration",
-        "4",
-        "--fs",
-        "500",
-        "--out",
-        path.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
-}
+mod common;
+use common::{hil_sim, scratch, simulate_noise};
 
 /// One error line (warnings may come before it).
 fn one_error(err: &str) -> bool {
@@ -56,9 +20,9 @@ const HOSTILE: &str = "<img src=x onerror=\"alert(1)\">.csv";
 /// report names no folder of the user's machine.
 #[test]
 fn hostile_file_name_is_text_in_the_report() {
-    let dir = tmp("inject");
+    let dir = scratch("inject");
     let rec = dir.join(HOSTILE);
-    simulate(&rec);
+    simulate_noise(&rec);
     for (cmd, extra) in [("fit", ["--model", "algebraic"]), ("diagnose", ["--model", "algebraic"])] {
         let out = dir.join(format!("rep-{cmd}"));
         let (code, _, err) = hil_sim(&[cmd, rec.to_str().unwrap(), extra[0], extra[1], "--out", out.to_str().unwrap()]);
@@ -79,9 +43,9 @@ fn hostile_file_name_is_text_in_the_report() {
 /// refused instead of followed.
 #[test]
 fn outputs_never_overwrite_inputs_or_follow_symlinks() {
-    let dir = tmp("overwrite");
+    let dir = scratch("overwrite");
     let rec = dir.join("rec.csv");
-    simulate(&rec);
+    simulate_noise(&rec);
     let before = std::fs::read(&rec).unwrap();
     let saved = dir.join("saved");
     let (code, _, err) =
@@ -142,7 +106,7 @@ fn outputs_never_overwrite_inputs_or_follow_symlinks() {
 /// once per cell (90 GB of copies, minutes); now the name is looked at only for a message.
 #[test]
 fn a_huge_header_field_is_read_once() {
-    let dir = tmp("wide");
+    let dir = scratch("wide");
     let rec = dir.join("wide.csv");
     let mut text = format!("t,x,{}\n", "c".repeat(30_000_000));
     for i in 0..3000 {

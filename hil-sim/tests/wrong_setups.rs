@@ -2,24 +2,10 @@
 //! an export for a model the firmware is not built with, absurd parameter values, and the
 //! same channel as input and output.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
-fn hil_sim(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_hil-sim")).args(args).output().unwrap();
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("hil-sim-setups-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod common;
+use common::{hil_sim, scratch, simulate_noise};
 
 fn one_error(err: &str) -> bool {
     err.lines().filter(|l| l.starts_with("error")).count() == 1
@@ -33,7 +19,7 @@ fn bouc_wen(alpha: f32) -> String {
 
 #[test]
 fn export_refuses_what_the_firmware_cannot_run() {
-    let dir = tmp("export");
+    let dir = scratch("export");
     let out = dir.join("page.bin");
     let out = out.to_str().unwrap();
     // A model the firmware is not built with (its `Loop` holds algebraic, bouc_wen, lugre, tanh).
@@ -59,24 +45,9 @@ fn export_refuses_what_the_firmware_cannot_run() {
 
 #[test]
 fn the_output_cannot_be_the_input() {
-    let dir = tmp("channels");
+    let dir = scratch("channels");
     let rec = dir.join("rec.csv");
-    let (code, _, err) = hil_sim(&[
-        "simulate",
-        "--effect",
-        "field_lag",
-        "--base",
-        "algebraic",
-        "--excitation",
-        "noise",
-        "--duration",
-        "4",
-        "--fs",
-        "500",
-        "--out",
-        rec.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    simulate_noise(&rec);
     let rec = rec.to_str().unwrap();
     for args in [
         vec!["fit", rec, "--model", "algebraic", "--input", "torque", "--output", "torque"],
