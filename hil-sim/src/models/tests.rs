@@ -59,3 +59,10 @@ fn unit_mapping_round_trips() {
     }
     assert!((b.from_unit(0.5) - 1.0).abs() < 1e-12);
 }
+
+#[test]
+fn published_values_are_the_printed_decimals() {
+    assert_eq!(published(46.9), 46.9);
+    assert_eq!(published(2.95), 2.95);
+    assert_eq!(dyke_1997().map(|v| v as f32), model_core::models::spencer::DYKE_1997_FLAT);
+}

@@ -370,12 +370,6 @@ pub const DYKE_1997: Params = Params {
 /// (`c0a, c0b, k0, c1a, c1b, k1, x0, alpha_a, alpha_b, gamma, beta, A, n, eta`).
 pub const DYKE_1997_FLAT: [f32; 14] = DYKE_1997.flat();
 
-/// The published decimals of [`DYKE_1997_FLAT`] as f64, for host code working in f64 (the
-/// f64 reference, fit start values): `f64::from` of the f32 set differs in the low bits
-/// (46.9f32 is 46.900001525…).
-pub const DYKE_1997_F64: [f64; 14] =
-    [21.0, 3.50, 46.9, 283.0, 2.95, 5.00, 14.3, 140.0, 695.0, 363.0, 363.0, 301.0, 2.0, 190.0];
-
 impl Model for Spencer {
     type State = State;
     const ID: &'static str = "spencer";
