@@ -13,7 +13,7 @@ use hil_sim::models::replay::replay_recording;
 use hil_sim::models::RateSpec;
 use hil_sim::numerics::metrics::Metrics;
 use hil_sim::report::fit::{error_bars, fit_plots, results_table, Labels};
-use hil_sim::report::plot::{self, Series, Style};
+use hil_sim::report::plot::{self, colour, Series, Style};
 use hil_sim::report::Report;
 use hil_sim::sim::plant::ClutchParams;
 use serde_json::json;
@@ -34,6 +34,7 @@ const TRAIN: f64 = 0.85;
 
 struct DykeFit {
     file: &'static str,
+    path: PathBuf,
     rec: Recording,
     data: Dataset,
     results: Vec<FitResult>,
@@ -54,7 +55,7 @@ fn fit_dyke(file: &'static str) -> anyhow::Result<DykeFit> {
     let ids = super::fit::model_list("all")?;
     eprintln!("fitting {} models on {file}", ids.len());
     let results = super::fit::fit_all(&data, &ids, &FitOptions::default())?;
-    Ok(DykeFit { file, rec, data, results, warnings })
+    Ok(DykeFit { file, path, rec, data, results, warnings })
 }
 
 fn loop_plots(rep: &mut Report, dir: &Path, lp: &Run, bl: &Run) -> anyhow::Result<()> {
@@ -68,10 +69,10 @@ fn loop_plots(rep: &mut Report, dir: &Path, lp: &Run, bl: &Run) -> anyhow::Resul
         "torque (N·m)",
         t,
         &[
-            Series::new("reference", &lp.reference[k0..k1]).style(Style::rgb(0, 0, 0).width(2)),
-            Series::new("estimate (Hall + model)", &lp.torque_est[k0..k1]),
-            Series::new("true torque, closed loop", &lp.torque_true[k0..k1]),
-            Series::new("true torque, open-loop baseline", &bl.torque_true[k0..k1]),
+            Series::new("reference", &lp.reference[k0..k1]).style(Style::of(colour::REFERENCE)),
+            Series::new("estimate (Hall + model)", &lp.torque_est[k0..k1]).style(Style::of(colour::MODEL).width(1)),
+            Series::new("true torque, closed loop", &lp.torque_true[k0..k1]).style(Style::of(colour::IMPROVED)),
+            Series::new("true torque, open-loop baseline", &bl.torque_true[k0..k1]).style(Style::of(colour::BASELINE)),
         ],
     )?;
     rep.image(
@@ -84,7 +85,10 @@ fn loop_plots(rep: &mut Report, dir: &Path, lp: &Run, bl: &Run) -> anyhow::Resul
         "time (s)",
         "current (A)",
         t,
-        &[Series::new("closed loop", &lp.coil_current[k0..k1]), Series::new("baseline", &bl.coil_current[k0..k1])],
+        &[
+            Series::new("closed loop", &lp.coil_current[k0..k1]).style(Style::of(colour::IMPROVED)),
+            Series::new("open-loop baseline", &bl.coil_current[k0..k1]).style(Style::of(colour::BASELINE)),
+        ],
     )?;
     rep.image("loop_current.svg", "coil current");
     plot::time_series(
@@ -93,7 +97,10 @@ fn loop_plots(rep: &mut Report, dir: &Path, lp: &Run, bl: &Run) -> anyhow::Resul
         "time (s)",
         "duty (−1…1)",
         t,
-        &[Series::new("closed loop", &lp.duty[k0..k1]), Series::new("baseline", &bl.duty[k0..k1])],
+        &[
+            Series::new("closed loop", &lp.duty[k0..k1]).style(Style::of(colour::IMPROVED).width(1)),
+            Series::new("open-loop baseline", &bl.duty[k0..k1]).style(Style::of(colour::BASELINE).width(1)),
+        ],
     )?;
     rep.image("loop_duty.svg", "PWM duty of the bipolar H-bridge");
     Ok(())
@@ -106,23 +113,26 @@ fn identification(rep: &mut Report, out: &Path, text: &mut String) -> anyhow::Re
     rep.paragraph(&format!(
         "Input D (cm), output F (N), command Y (V). Each model is fitted on the first {:.0} % (time-ordered) and \
          scored on the rest, with the f32 core the firmware runs. Samples flagged by the quality checks are left \
-         out of the fit; the held-out metrics cover every held-out sample.",
+         out of the fit; the held-out metrics cover every held-out sample, and where some were flagged the \
+         table also scores the unflagged ones.",
         100.0 * TRAIN
     ));
     for f in &fits {
         rep.heading_level(3, f.file);
         for w in &f.warnings {
-            rep.paragraph(&format!("Quality warning: {w}"));
+            rep.paragraph(&format!("**Quality warning:** {}", hil_sim::report::relabel(w, &f.path)));
         }
-        results_table(rep, &f.results);
+        let labels = Labels { input: "D (cm)".into(), output: "F (N)".into() };
+        results_table(rep, &f.results, &labels);
         let stem = f.file.trim_start_matches("dyke/").trim_end_matches(".csv").to_owned();
         error_bars(rep, out, &stem, &f.results)?;
         if let Some(best) = f.results.iter().min_by(|x, y| x.heldout.rmse.total_cmp(&y.heldout.rmse)) {
             rep.paragraph(&format!(
-                "Best held-out: **{}**, RMSE {:.1} N, R² {:.4}, fitted in {:.2} s.",
-                best.model, best.heldout.rmse, best.heldout.r2, best.fit_seconds
+                "Best held-out: **{}**, fitted in {:.2} s. {}",
+                best.model,
+                best.fit_seconds,
+                hil_sim::report::scores::heldout_note(&f.data, best, "F", "N")
             ));
-            let labels = Labels { input: "D (cm)".into(), output: "F (N)".into() };
             fit_plots(rep, out, &format!("{stem}_{}", best.model), &f.data, best, &labels)?;
         }
         *text += &format!("\n{} (fit on the first {:.0} %, scored on the rest)\n", f.file, 100.0 * TRAIN);
@@ -217,7 +227,8 @@ fn accuracy(rep: &mut Report) -> anyhow::Result<(usize, f64)> {
         100.0 * worst
     ));
     rep.heading("Models (model-core, no_std, f32, fixed step)");
-    rep.paragraph(&format!("```\n{}```", super::models::table()));
+    let (headers, rows) = super::models::rows();
+    rep.table(&headers, &rows);
     Ok((acc.len(), worst))
 }
 

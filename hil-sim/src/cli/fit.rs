@@ -120,8 +120,15 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
     }
     if let Some(dir) = &a.out {
         let title = format!("Fit of {}", hil_sim::report::file_label(path));
-        let labels = Labels { input: a.ch.input.clone(), output: a.ch.output.clone() };
-        let index = fit_page::write(dir, &title, data, &run.results, &labels)?;
+        let labels = Labels::for_channels(&a.ch.input, &a.ch.output);
+        let warnings: Vec<String> = q
+            .warnings
+            .iter()
+            .map(|w| w.message.clone())
+            .chain(q.notes.iter().cloned())
+            .map(|m| hil_sim::report::relabel(&m, path))
+            .collect();
+        let index = fit_page::write(dir, &title, data, &run.results, &labels, &warnings)?;
         eprintln!("report written to {}", index.display());
     }
     let best = run.best().map(|r| r.model.clone());

@@ -40,3 +40,21 @@ pub fn table() -> String {
     }
     s
 }
+
+/// The model table for a report: headers and one row per model, every parameter named.
+pub fn rows() -> (Vec<String>, Vec<Vec<String>>) {
+    let headers = ["model", "params", "state (B)", "source", "parameter names"].map(String::from).to_vec();
+    let rows = MODELS
+        .iter()
+        .map(|m| {
+            vec![
+                m.id.to_owned(),
+                m.n_params.to_string(),
+                m.state_bytes.to_string(),
+                m.source.to_owned(),
+                m.params.join(", "),
+            ]
+        })
+        .collect();
+    (headers, rows)
+}

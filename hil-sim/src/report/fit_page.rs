@@ -20,16 +20,21 @@ pub enum FitPageError {
     Report(#[from] ReportError),
 }
 
-/// Write a fit report: the table, the error bars, and the plots of the best model (by
-/// held-out RMSE). Returns the path of `index.html`.
+/// Write a fit report: the quality warnings (already free of the user's folders), the
+/// table, the error bars, and the plots of the best model (by held-out RMSE). Returns the
+/// path of `index.html`.
 pub fn write(
     dir: &std::path::Path,
     title: &str,
     data: &Dataset,
     results: &[FitResult],
     labels: &Labels,
+    warnings: &[String],
 ) -> Result<PathBuf, FitPageError> {
     let mut rep = Report::new(title);
+    for w in warnings {
+        rep.paragraph(&format!("**Quality warning:** {w}"));
+    }
     rep.paragraph(&format!(
         "{} samples at {:.1} Hz; fitted on the first {} samples, scored on the last {}. Metrics are from the \
          f32 replay through model-core (the firmware's code), one step per sample.",
@@ -38,11 +43,12 @@ pub fn write(
         data.train_end,
         data.len() - data.train_end
     ));
-    results_table(&mut rep, results);
+    results_table(&mut rep, results, labels);
     let stem = |m: &str| format!("fit_{m}");
     error_bars(&mut rep, dir, "fit", results)?;
     if let Some(best) = results.iter().min_by(|x, y| x.heldout.rmse.total_cmp(&y.heldout.rmse)) {
         rep.heading(&format!("Best held-out model: {}", best.model));
+        rep.paragraph(&super::scores::heldout_note(data, best, labels.output_name(), labels.output_unit()));
         fit_plots(&mut rep, dir, &stem(&best.model), data, best, labels)?;
     }
     for r in results.iter().filter(|r| !r.warnings.is_empty()) {

@@ -16,7 +16,9 @@
 pub mod diagnose;
 pub mod fit;
 pub mod fit_page;
+pub mod number;
 pub mod plot;
+pub mod scores;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -159,13 +161,18 @@ impl Report {
     }
 }
 
-const CSS: &str = "body { font-family: sans-serif; max-width: 1040px; margin: 2em auto; padding: 0 1em; color: #222; }
-table { border-collapse: collapse; margin: 1em 0; }
-th, td { border: 1px solid #ccc; padding: 0.3em 0.7em; text-align: left; }
-th { background: #f3f3f3; }
+/// The page's style: fits a 1400 px window without sideways scrolling; a table wider than
+/// the page scrolls inside itself rather than pushing the page wider.
+const CSS: &str = "body { font-family: sans-serif; max-width: 1280px; margin: 1.5em auto; padding: 0 1em; color: #222; line-height: 1.4; }
+table { border-collapse: collapse; margin: 1em 0; font-size: 0.88em; display: block; max-width: 100%; overflow-x: auto; }
+th, td { border: 1px solid #ccc; padding: 0.25em 0.5em; text-align: left; vertical-align: top; }
+th { background: #f3f3f3; vertical-align: bottom; }
 td { font-variant-numeric: tabular-nums; }
 img, .figure svg { max-width: 100%; height: auto; display: block; }
-code { background: #f3f3f3; padding: 0 0.2em; }
+.figure svg { max-width: 1000px; }
+code { background: #f3f3f3; padding: 0 0.2em; overflow-wrap: anywhere; }
+pre { overflow-x: auto; white-space: pre-wrap; }
+p { overflow-wrap: anywhere; }
 ";
 
 /// The SVG at `dir/rel` without any XML prolog, if `rel` is a relative `.svg` path that
@@ -185,6 +192,15 @@ fn inline_svg(dir: &Path, rel: &str) -> Option<String> {
 /// How a report names a file: its name only, never the folders of the user's machine.
 pub fn file_label(path: &Path) -> String {
     path.file_name().map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned())
+}
+
+/// A message about `path` as a report shows it: the file's folders left out.
+pub fn relabel(msg: &str, path: &Path) -> String {
+    let full = path.display().to_string();
+    if full.is_empty() {
+        return msg.to_owned();
+    }
+    msg.replace(&full, &file_label(path))
 }
 
 /// A link the page may carry: to the web or relative (no `javascript:`, `data:`, …).

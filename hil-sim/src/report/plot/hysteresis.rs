@@ -6,9 +6,10 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::canvas::{chart, draw_line, legend, mesh, render};
+use super::canvas::{chart, draw_line, legend_strip, mesh, render, split_legend, Mark};
 use super::decimate::xy_decimate;
-use super::range::{headroom, pad, range_of};
+use super::range::{pad, range_of};
+use super::style::{colour, rgb};
 use super::{no_finite, nonempty, same_len, PlotError};
 
 /// Output against input: the measured loop as a thin light line, the model's loop drawn
@@ -28,18 +29,20 @@ pub fn hysteresis_loop(
     same_len("model", model.len(), x.len())?;
     let xr = range_of(x.iter().copied()).ok_or_else(|| no_finite("input"))?;
     let yr = range_of(measured.iter().chain(model).copied()).ok_or_else(|| no_finite("outputs"))?;
-    let (xr, yr) = (pad(xr, 0.03), headroom(pad(yr, 0.05), 2));
+    let (xr, yr) = (pad(xr, 0.03), pad(yr, 0.05));
     let meas = xy_decimate(x, measured, &xr, &yr);
     let modl = xy_decimate(x, model, &xr, &yr);
     render(path, |root| {
-        let mut chart = chart(root, title, xr.clone(), yr.clone())?;
+        let (area, strip) = split_legend(root);
+        let mut chart = chart(&area, title, xr.clone(), yr.clone())?;
         mesh(&mut chart, x_label, y_label)?;
-        let light = RGBColor(90, 90, 90).mix(0.45).stroke_width(1);
-        draw_line(&mut chart, &meas, light, Some("measured"))?;
+        let light = rgb(colour::MEASURED).mix(0.45).stroke_width(1);
+        draw_line(&mut chart, &meas, light)?;
         // A dense model loop in 2 px hides the measurement under it.
         let points: usize = modl.iter().map(Vec::len).sum();
         let width = if points > 2_000 { 1 } else { 2 };
-        draw_line(&mut chart, &modl, RGBColor(213, 94, 0).mix(0.85).stroke_width(width), Some("model"))?;
-        legend(&mut chart)
+        let model = rgb(colour::MODEL).mix(0.85).stroke_width(width);
+        draw_line(&mut chart, &modl, model)?;
+        legend_strip(&strip, &[("measured".into(), Mark::Line(light)), ("model".into(), Mark::Line(model))])
     })
 }

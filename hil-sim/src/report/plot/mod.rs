@@ -12,7 +12,7 @@
 //!
 //! One file per plot kind: [`time_series()`] (lines over time), [`residual()`] (a residual
 //! over time with shaded windows), [`hysteresis_loop()`] (output against input) and [`bars()`]
-//! (grouped bars); `canvas` holds the shared picture, axes, legend and tick labels,
+//! (grouped horizontal bars); `canvas` holds the shared picture, axes, the legend strip under the chart and tick labels,
 //! `range` the axis ranges, `decimate` the reduction of long series, `style` the colours.
 
 use std::path::PathBuf;
@@ -28,20 +28,20 @@ mod residual;
 mod style;
 mod time_series;
 
-pub use bars::bars;
+pub use bars::{bars, bars_coloured};
 pub use hysteresis::hysteresis_loop;
-pub use residual::residual;
-pub use style::{Style, PALETTE};
-pub use time_series::{time_series, Series};
+pub use residual::{residual, residual_shaded};
+pub use style::{colour, Style, PALETTE};
+pub use time_series::{time_series, time_series_marked, Series};
 
 /// Picture size in pixels (width, height).
-pub const SIZE: (u32, u32) = (1000, 500);
+pub const SIZE: (u32, u32) = (1000, 530);
 /// Most points per x–y series after pixel de-duplication.
 pub const MAX_XY_POINTS: usize = 40_000;
 
 /// Plot area width used for decimation (picture width less the y label area and margins).
 const PLOT_W: usize = (SIZE.0 - 110) as usize;
-const PLOT_H: usize = (SIZE.1 - 100) as usize;
+const PLOT_H: usize = (SIZE.1 - 134) as usize;
 
 /// Why a plot was not written.
 #[derive(Debug, Error)]

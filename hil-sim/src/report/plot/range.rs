@@ -1,9 +1,7 @@
 //! Axis ranges: the range of the finite values, padded (constant series get a span from
-//! their magnitude) and with headroom for the legend.
+//! their magnitude).
 
 use std::ops::Range;
-
-use super::PLOT_H;
 
 /// Range of the finite values, `None` if there are none.
 pub(super) fn range_of(v: impl Iterator<Item = f64>) -> Option<Range<f64>> {
@@ -27,13 +25,4 @@ pub(super) fn pad(r: Range<f64>, frac: f64) -> Range<f64> {
     let mid = 0.5 * (r.start + r.end);
     let half = if mid == 0.0 { 1.0 } else { 0.1 * mid.abs() };
     (mid - half)..(mid + half)
-}
-
-/// Extend the top of `r` so that a legend of `entries` lines in the upper right corner
-/// sits above the data rather than over it.
-pub(super) fn headroom(r: Range<f64>, entries: usize) -> Range<f64> {
-    let legend_px = (22 * entries + 24) as f64;
-    let frac = (legend_px / PLOT_H as f64).min(0.5);
-    let span = r.end - r.start;
-    r.start..(r.end + span * frac / (1.0 - frac))
 }

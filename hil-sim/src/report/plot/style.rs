@@ -1,5 +1,6 @@
-//! How series are drawn: colour (the Okabe–Ito palette by default), stroke width in
-//! pixels, opacity; and the fonts of captions, axis labels and ticks.
+//! How series are drawn: colour, stroke width in pixels, opacity; the fonts of captions,
+//! axis labels and ticks; and the colours that mean one thing in every plot of a report
+//! ([`colour`]), so that orange is the model's output wherever it appears.
 
 use plotters::prelude::*;
 
@@ -12,6 +13,28 @@ pub(super) const TICK_PX: u32 = 16;
 /// Colour-blind safe palette (Okabe–Ito), used in order for series without a colour.
 pub const PALETTE: [(u8, u8, u8); 7] =
     [(0, 114, 178), (213, 94, 0), (0, 158, 115), (204, 121, 167), (230, 159, 0), (86, 180, 233), (90, 90, 90)];
+
+/// One meaning per colour across every plot (Okabe–Ito hues).
+pub mod colour {
+    /// What was measured, or the plant's true value: dark grey.
+    pub const MEASURED: (u8, u8, u8) = (70, 70, 70);
+    /// The model's output or estimate: vermillion.
+    pub const MODEL: (u8, u8, u8) = (213, 94, 0);
+    /// The improved result: the closed loop, the model with a finding's term: bluish green.
+    pub const IMPROVED: (u8, u8, u8) = (0, 158, 115);
+    /// What the result is compared with: the open-loop baseline, the base model: reddish purple.
+    pub const BASELINE: (u8, u8, u8) = (204, 121, 167);
+    /// A residual (measured − model): blue.
+    pub const RESIDUAL: (u8, u8, u8) = (0, 114, 178);
+    /// A reference to follow: black.
+    pub const REFERENCE: (u8, u8, u8) = (0, 0, 0);
+    /// Samples the quality checks flagged, or a finding's windows (shaded): orange.
+    pub const FLAGGED: (u8, u8, u8) = (230, 159, 0);
+    /// The boundary between the training and the held-out parts: red.
+    pub const BOUNDARY: (u8, u8, u8) = (200, 0, 0);
+    /// Scores on the training part: light grey.
+    pub const TRAIN: (u8, u8, u8) = (170, 170, 170);
+}
 
 /// How one series is drawn.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,6 +58,10 @@ impl Style {
     pub const fn rgb(r: u8, g: u8, b: u8) -> Self {
         Self { color: Some((r, g, b)), width: 2, opacity: 1.0 }
     }
+    /// A solid line of one of the [`colour`] constants, 2 px, slightly transparent.
+    pub const fn of(c: (u8, u8, u8)) -> Self {
+        Self { color: Some(c), width: 2, opacity: 0.9 }
+    }
     pub const fn width(mut self, width: u32) -> Self {
         self.width = width;
         self
@@ -48,4 +75,9 @@ impl Style {
         let a = if self.opacity.is_finite() { self.opacity.clamp(0.0, 1.0) } else { 1.0 };
         RGBColor(r, g, b).mix(a).stroke_width(self.width.max(1))
     }
+}
+
+/// A colour constant as a plotters colour.
+pub(super) fn rgb(c: (u8, u8, u8)) -> RGBColor {
+    RGBColor(c.0, c.1, c.2)
 }

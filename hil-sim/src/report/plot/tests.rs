@@ -140,14 +140,38 @@ fn residual_with_windows_and_train_marker() {
     )
     .unwrap();
     let s = read_svg(&p);
-    for want in ["Residual, held-out part shaded", "residual", "windows", "end of training", "held-out"] {
+    for want in
+        ["Residual, held-out part shaded", "residual", "flagged by the quality checks", "end of training", "held-out"]
+    {
         assert!(s.contains(want), "missing {want}");
     }
     assert!(s.len() < 1_000_000);
     // No windows, marker outside the axis: plain residual plot.
     residual(&p, "plain", "r (N)", &t, &y, &[], Some(1e9)).unwrap();
     let s = read_svg(&p);
-    assert!(!s.contains("end of training") && !s.contains("windows"));
+    assert!(!s.contains("end of training") && !s.contains("flagged"));
+}
+
+#[test]
+fn time_series_marks_the_boundary_and_puts_the_legend_under_the_chart() {
+    let (t, y) = sine(3000, 2.0, 1e-3);
+    let p = tmp("ts_marked.svg");
+    time_series_marked(&p, "around the boundary", "time (s)", "F (N)", &t, &[Series::new("measured", &y)], Some(1.5))
+        .unwrap();
+    let s = read_svg(&p);
+    assert!(s.contains("end of training") && s.contains("held-out"));
+    // The legend's text sits below the plot area: under the x axis label.
+    let y_of = |text: &str| -> f64 {
+        let el = s
+            .split("<text")
+            .skip(1)
+            .find(|e| e.split_once('>').unwrap().1.split("</text>").next().unwrap().trim() == text);
+        let attrs = el.unwrap().split_once('>').unwrap().0;
+        attrs.split(" y=\"").nth(1).unwrap().split('"').next().unwrap().parse().unwrap()
+    };
+    assert!(y_of("measured") > y_of("time (s)"), "legend over the chart");
+    time_series_marked(&p, "outside", "time (s)", "F (N)", &t, &[Series::new("m", &y)], Some(99.0)).unwrap();
+    assert!(!read_svg(&p).contains("end of training"));
 }
 
 #[test]

@@ -1,12 +1,15 @@
 //! Lines over time with a legend (e.g. measured and model output), each decimated to its
-//! M4 envelope (per pixel column: first, lowest, highest, last point).
+//! M4 envelope (per pixel column: first, lowest, highest, last point), optionally with the
+//! train/held-out boundary drawn as a dashed line.
 
 use std::path::Path;
 
-use super::canvas::{chart, draw_line, legend, mesh, render};
+use plotters::style::Color;
+
+use super::canvas::{boundary, chart, draw_line, legend_strip, mesh, render, split_legend, Mark};
 use super::decimate::envelope;
-use super::range::{headroom, pad, range_of};
-use super::style::Style;
+use super::range::{pad, range_of};
+use super::style::{colour, rgb, Style};
 use super::{no_finite, nonempty, same_len, PlotError, PLOT_W};
 
 /// One line of a [`time_series`] plot.
@@ -41,6 +44,19 @@ pub fn time_series(
     t: &[f64],
     series: &[Series<'_>],
 ) -> Result<(), PlotError> {
+    time_series_marked(path, title, x_label, y_label, t, series, None)
+}
+
+/// [`time_series`] with a dashed line at `train_end` (s), the end of the training part.
+pub fn time_series_marked(
+    path: impl AsRef<Path>,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    t: &[f64],
+    series: &[Series<'_>],
+    train_end: Option<f64>,
+) -> Result<(), PlotError> {
     let path = path.as_ref();
     nonempty("time axis", t.len())?;
     if series.is_empty() {
@@ -53,11 +69,19 @@ pub fn time_series(
     let lines: Vec<Vec<Vec<(f64, f64)>>> = series.iter().map(|s| envelope(t, s.values, xr.clone(), PLOT_W)).collect();
     let yr = range_of(lines.iter().flatten().flatten().map(|p| p.1)).ok_or_else(|| no_finite("series values"))?;
     render(path, |root| {
-        let mut chart = chart(root, title, pad(xr, 0.0), headroom(pad(yr, 0.05), series.len()))?;
+        let (area, strip) = split_legend(root);
+        let mut chart = chart(&area, title, pad(xr.clone(), 0.0), pad(yr, 0.05))?;
         mesh(&mut chart, x_label, y_label)?;
+        let mut entries = Vec::new();
         for (i, (s, segs)) in series.iter().zip(&lines).enumerate() {
-            draw_line(&mut chart, segs, s.style.shape(i), Some(s.name))?;
+            draw_line(&mut chart, segs, s.style.shape(i))?;
+            entries.push((s.name.to_owned(), Mark::Line(s.style.shape(i))));
         }
-        legend(&mut chart)
+        if let Some(te) = train_end.filter(|v| xr.contains(v)) {
+            let mark = rgb(colour::BOUNDARY).stroke_width(2);
+            boundary(&mut chart, &area, te, "train ← | → held-out", mark)?;
+            entries.push(("end of training".to_owned(), Mark::Dashed(mark)));
+        }
+        legend_strip(&strip, &entries)
     })
 }
