@@ -12,6 +12,10 @@ use super::range::{pad, range_of};
 use super::style::{CAPTION_PX, FONT, LABEL_PX, PALETTE, TICK_PX};
 use super::{no_finite, nonempty, same_len, PlotError, SIZE};
 
+/// One group of bars: its legend name, one value per category, and its colour (`None`:
+/// the palette's next).
+pub type BarGroup<'a> = (&'a str, &'a [f64], Option<(u8, u8, u8)>);
+
 /// Height of one bar, pixels.
 const BAR_PX: u32 = 11;
 
@@ -26,8 +30,7 @@ pub fn bars<S: AsRef<str>, V: AsRef<[f64]>>(
     categories: &[String],
     groups: &[(S, V)],
 ) -> Result<(), PlotError> {
-    let coloured: Vec<(&str, &[f64], Option<(u8, u8, u8)>)> =
-        groups.iter().map(|(n, v)| (n.as_ref(), v.as_ref(), None)).collect();
+    let coloured: Vec<BarGroup<'_>> = groups.iter().map(|(n, v)| (n.as_ref(), v.as_ref(), None)).collect();
     bars_coloured(path, title, x_label, categories, &coloured)
 }
 
@@ -37,7 +40,7 @@ pub fn bars_coloured(
     title: &str,
     x_label: &str,
     categories: &[String],
-    groups: &[(&str, &[f64], Option<(u8, u8, u8)>)],
+    groups: &[BarGroup<'_>],
 ) -> Result<(), PlotError> {
     let path = path.as_ref();
     nonempty("categories", categories.len())?;
