@@ -141,6 +141,7 @@ impl Report {
                 _ => events.push(ev),
             }
         }
+        name_headings(&mut events);
         let mut body = String::new();
         html::push_html(&mut body, events.into_iter());
         format!(
@@ -170,10 +171,45 @@ th { background: #f3f3f3; vertical-align: bottom; }
 td { font-variant-numeric: tabular-nums; }
 img, .figure svg { max-width: 100%; height: auto; display: block; }
 .figure svg { max-width: 1000px; }
-code { background: #f3f3f3; padding: 0 0.2em; overflow-wrap: anywhere; }
+code { background: #f3f3f3; padding: 0 0.2em; }
+td code { white-space: nowrap; }
 pre { overflow-x: auto; white-space: pre-wrap; }
 p { overflow-wrap: anywhere; }
 ";
+
+/// Give every heading an `id` made of its words (`## Closed loop` → `closed-loop`), so a
+/// section can be linked to and screenshotted; repeated names get `-2`, `-3`, ….
+fn name_headings(events: &mut [Event<'_>]) {
+    let mut seen = std::collections::HashMap::<String, usize>::new();
+    for i in 0..events.len() {
+        if !matches!(events[i], Event::Start(Tag::Heading { .. })) {
+            continue;
+        }
+        let mut words = String::new();
+        for ev in &events[i + 1..] {
+            match ev {
+                Event::End(TagEnd::Heading(_)) => break,
+                Event::Text(t) | Event::Code(t) => words.push_str(t),
+                _ => {}
+            }
+        }
+        let mut slug = String::new();
+        for c in words.chars().flat_map(char::to_lowercase) {
+            if c.is_alphanumeric() {
+                slug.push(c);
+            } else if !slug.is_empty() && !slug.ends_with('-') {
+                slug.push('-');
+            }
+        }
+        let slug = slug.trim_end_matches('-').to_owned();
+        let n = seen.entry(slug.clone()).or_insert(0);
+        *n += 1;
+        let id = if *n == 1 { slug } else { format!("{slug}-{n}") };
+        if let Event::Start(Tag::Heading { id: slot, .. }) = &mut events[i] {
+            *slot = Some(CowStr::from(id));
+        }
+    }
+}
 
 /// The SVG at `dir/rel` without any XML prolog, if `rel` is a relative `.svg` path that
 /// stays inside `dir` and can be read.
@@ -261,7 +297,7 @@ mod tests {
         let html = std::fs::read_to_string(&index).unwrap();
         assert!(html.starts_with("<!DOCTYPE html>"));
         assert!(html.contains("<title>Fit &lt;report&gt;</title>"));
-        assert!(html.contains("<h2>Held-out error</h2>"));
+        assert!(html.contains("<h2 id=\"held-out-error\">Held-out error</h2>"), "{html}");
         assert!(html.contains("<table>") && html.contains("<th>RMSE (N)</th>") && html.contains("<td>a|b</td>"));
         assert!(html.contains("<em>recording</em>"));
         assert!(html.contains("LOOPMARK"), "SVG not inlined");
