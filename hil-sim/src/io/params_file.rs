@@ -19,6 +19,8 @@ pub enum ParamsFileError {
     Io { path: PathBuf, source: std::io::Error },
     #[error("{path}: not a valid parameter file: {source}")]
     Json { path: PathBuf, source: serde_json::Error },
+    #[error("{path}: {bytes} bytes, more than the {max} a parameter file can need (the largest model has about 100 parameters)")]
+    TooLarge { path: PathBuf, bytes: u64, max: u64 },
     #[error("{path}: unknown model `{model}` (see `hil-sim models`)")]
     UnknownModel { path: PathBuf, model: String },
     #[error("{path}: {model}: {reason}")]
@@ -70,12 +72,26 @@ pub fn block(name: &str) -> (&str, usize) {
     }
 }
 
+/// Largest parameter file read, bytes: far above any model's set (a few kB), far below what
+/// parsing a hostile file into memory could cost.
+pub const MAX_BYTES: u64 = 1 << 20;
+
 impl ParamsFile {
+    /// Read and parse a parameter file; files over [`MAX_BYTES`] are refused unread.
     pub fn read(path: &Path) -> Result<Self, ParamsFileError> {
         crate::io::output::note_input(path);
-        let text =
-            std::fs::read_to_string(path).map_err(|source| ParamsFileError::Io { path: path.to_path_buf(), source })?;
-        serde_json::from_str(&text).map_err(|source| ParamsFileError::Json { path: path.to_path_buf(), source })
+        let io = |source| ParamsFileError::Io { path: path.to_path_buf(), source };
+        let bytes = std::fs::metadata(path).map_err(io)?.len();
+        if bytes > MAX_BYTES {
+            return Err(ParamsFileError::TooLarge { path: path.to_path_buf(), bytes, max: MAX_BYTES });
+        }
+        let text = std::fs::read_to_string(path).map_err(io)?;
+        Self::parse(path, &text)
+    }
+
+    /// Parse a parameter file's text (`path` names it in errors).
+    pub fn parse(path: &Path, text: &str) -> Result<Self, ParamsFileError> {
+        serde_json::from_str(text).map_err(|source| ParamsFileError::Json { path: path.to_path_buf(), source })
     }
 
     /// The flat f32 vector in the model's parameter order.
@@ -112,6 +128,10 @@ impl ParamsFile {
         }
         if let Some(i) = flat.iter().position(|v| !v.is_finite()) {
             return Err(err(format!("value #{i} is not finite")));
+        }
+        // The core runs in f32: a value beyond its range would become infinite there.
+        if let Some((i, v)) = flat.iter().enumerate().find(|(_, v)| !(**v as f32).is_finite()) {
+            return Err(err(format!("value #{i} = {v:e} is beyond the f32 range of the core (±3.4e38)")));
         }
         Ok(flat.iter().map(|v| *v as f32).collect())
     }

@@ -111,8 +111,8 @@ pub enum ScenarioError {
     Unknown { name: String, list: String },
     #[error("{path}: cannot read: {source}")]
     Io { path: PathBuf, source: std::io::Error },
-    #[error("{path}: {source}")]
-    Toml { path: PathBuf, source: toml::de::Error },
+    #[error("{path}: line {line}, column {column}: {message}")]
+    Toml { path: PathBuf, line: usize, column: usize, message: String },
     #[error("{path}: {what}")]
     Invalid { path: PathBuf, what: String },
 }
@@ -300,8 +300,16 @@ impl Scenario {
 
     /// Parse TOML text; `path` names it in messages.
     pub fn parse(path: &Path, text: &str) -> Result<Self, ScenarioError> {
-        let s: Self =
-            toml::from_str(text).map_err(|source| ScenarioError::Toml { path: path.to_path_buf(), source })?;
+        let s: Self = toml::from_str(text).map_err(|e: toml::de::Error| {
+            let at = e.span().map_or(0, |r| r.start).min(text.len());
+            let before = text.get(..at).unwrap_or("");
+            ScenarioError::Toml {
+                path: path.to_path_buf(),
+                line: before.matches('\n').count() + 1,
+                column: before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1,
+                message: e.message().split_whitespace().collect::<Vec<_>>().join(" "),
+            }
+        })?;
         let bad = |what: &str| Err(ScenarioError::Invalid { path: path.to_path_buf(), what: what.into() });
         if !(s.duration_s > 0.0 && s.duration_s.is_finite()) {
             return bad("duration_s must be > 0");
