@@ -452,7 +452,7 @@ fn mutate_json(v: &mut serde_json::Value, rng: &mut StdRng) {
                 let s = hostile_number(rng);
                 s.parse::<f64>()
                     .ok()
-                    .and_then(|f| serde_json::Number::from_f64(f))
+                    .and_then(serde_json::Number::from_f64)
                     .map_or(serde_json::json!(s), serde_json::Value::Number)
             }
         };
@@ -590,7 +590,7 @@ fn numeric_flags(sub: &str) -> Vec<String> {
 
 #[test]
 fn generated_numbers_on_the_command_line() {
-    let mut rng = StdRng::seed_from_u64(seed() ^ 0x434c_49);
+    let mut rng = StdRng::seed_from_u64(seed() ^ 0x0043_4c49);
     let d = scratch("gen-cli");
     let (rec, files) = fitted(&d);
     let rec = rec.display().to_string();
