@@ -5,3 +5,4 @@ pub mod compare;
 pub mod dataset;
 pub mod diagnose;
 pub mod fit;
+pub mod runs;

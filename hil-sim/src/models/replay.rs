@@ -151,6 +151,28 @@ pub fn replay(id: &str, params: &[f32], dt: f32, rate: RateSpec, samples: &[Samp
         .map_err(|source| ReplayError::Params { model: id.to_owned(), source })
 }
 
+/// [`replay`] of a dataset whose runs start at `starts`: the core (state and rate
+/// estimator) restarts at every run.
+pub fn replay_runs(
+    id: &str,
+    params: &[f32],
+    dt: f32,
+    rate: RateSpec,
+    samples: &[Sample],
+    starts: &[usize],
+) -> Result<Replay, ReplayError> {
+    let n = samples.len();
+    let mut out = Replay { y: Vec::with_capacity(n), held: 0 };
+    let mut a = 0;
+    for b in starts.iter().copied().filter(|&s| s > 0 && s < n).chain([n]) {
+        let r = replay(id, params, dt, rate, samples.get(a..b).unwrap_or(&[]))?;
+        out.y.extend(r.y);
+        out.held += r.held;
+        a = b;
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod sample_tests {
     use super::*;

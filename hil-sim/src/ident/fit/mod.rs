@@ -23,6 +23,7 @@ pub mod narx;
 pub mod narx_net;
 pub mod objective;
 pub mod operator;
+mod per_run;
 pub mod simulate;
 
 use std::time::Instant;
@@ -33,13 +34,15 @@ use thiserror::Error;
 
 use crate::io::params_file::{ParamsFile, Values};
 use crate::models::search::{ModelSpec, Scales, Strategy, Structure};
-use crate::models::{replay, RateSpec};
+use crate::models::RateSpec;
 use crate::numerics::derivative::gradient;
 use crate::numerics::metrics::{metrics, Metrics};
 use global::SwarmOptions;
 
 pub use crate::ident::dataset::{Dataset, DatasetError};
 use objective::Objective;
+use per_run::per_run_metrics;
+pub use per_run::RunMetrics;
 
 /// Both parts keep samples to score under the delays `ds` (samples, step `dt` s).
 fn scored_parts(train: &[usize], heldout: &[usize], ds: (f64, f64), dt: f64) -> Result<(), FitError> {
@@ -153,6 +156,9 @@ pub struct FitResult {
     pub state_bytes: usize,
     /// Samples whose output the core held (non-finite or overflow) in the replay.
     pub held: usize,
+    /// Each run's metrics, for a dataset of several recordings (empty for one).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub runs: Vec<RunMetrics>,
     /// What the fit noticed about the fitted set (e.g. a non-physical crossing loop of the
     /// asymmetric Bouc–Wen model, seed 004 on eq. 30).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -176,8 +182,10 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     let started = Instant::now();
     let dt = data.dt as f32;
     let samples = data.samples();
-    let kin = simulate::kinematics(&samples, dt, sp.rate).ok_or(FitError::RateOverflow { model: id.to_owned() })?;
-    let sim = simulate::simulator(id, dt).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
+    let starts = data.run_starts();
+    let kin = simulate::kinematics_runs(&samples, dt, sp.rate, &starts)
+        .ok_or(FitError::RateOverflow { model: id.to_owned() })?;
+    let sim = simulate::simulator_runs(id, dt, &starts).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
     let rows = data.train_rows();
     let fit_at = |kin: &[model_core::Kin], sp: &ModelSpec| {
         identify_variants(id, sp, sim.as_ref(), kin, &data.output, &rows, &scales, opts)
@@ -189,13 +197,13 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
             let d = (s / data.dt, if data.command.is_some() { s_u / data.dt } else { 0.0 });
             crate::models::alignment::check(data.len(), data.dt, &[d.0, d.1])?;
             let mut shifted = Vec::new();
-            crate::models::alignment::shift_kin(&kin, d.0, d.1, &mut shifted);
+            crate::models::alignment::shift_kin_runs(&kin, d.0, d.1, &starts, &mut shifted);
             (fit_at(&shifted, &sp)?, d)
         }
         // A network has past inputs for the lags it needs.
         (DelayChoice::Auto, Strategy::Network) => (fit_at(&kin, &sp)?, (0.0, 0.0)),
         (DelayChoice::Auto, Strategy::Linear | Strategy::Operator) => {
-            let found = scan_delay(&kin, |k| {
+            let found = scan_delay(&kin, &starts, |k| {
                 let r = fit_at(k, &sp).ok()?;
                 let cost = Objective::new(sim.as_ref(), &sp, k, &data.output, &rows, scales.y).cost(&r.0);
                 Some((r, cost))
@@ -218,7 +226,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     let mut warnings = Vec::new();
     if sp.structure == Structure::AsymmetricBoucWen {
         let mut shifted = Vec::new();
-        crate::models::alignment::shift_kin(&kin, delay, delay_u, &mut shifted);
+        crate::models::alignment::shift_kin_runs(&kin, delay, delay_u, &starts, &mut shifted);
         if operator::abw_crossing(&params, dt, &shifted, &rows) == Some(true) {
             let eq = if params.get(11).copied() == Some(1.0) { "eq. 30" } else { "eq. 31" };
             warnings.push(format!(
@@ -231,35 +239,33 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     // Score with the Estimator path, the firmware's code, over the whole recording.
     let p32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
     // The channels as the model saw them (as recorded when no delay was fitted).
-    let (input, command) =
-        crate::models::alignment::shift_channels(&data.input, data.command.as_deref(), delay, delay_u);
+    let shift = |v: &[f64], d: f64| crate::models::alignment::shift_runs(v, d, &starts);
+    let input = shift(&data.input, delay);
+    let command = data.command.as_deref().map(|u| shift(u, delay_u));
     let samples = if delay == 0.0 && delay_u == 0.0 {
         samples
     } else {
-        let rates = data
-            .rates
-            .as_ref()
-            .map(|(dx, ddx)| (crate::models::alignment::shift(dx, delay), crate::models::alignment::shift(ddx, delay)));
+        let rates = data.rates.as_ref().map(|(dx, ddx)| (shift(dx, delay), shift(ddx, delay)));
         crate::models::replay::samples_with_rates(&input, command.as_deref(), rates.as_ref())
     };
     let t0 = Instant::now();
-    let rep = replay(id, &p32, dt, sp.rate, &samples)
+    let rep = crate::models::replay::replay_runs(id, &p32, dt, sp.rate, &samples, &starts)
         .map_err(|e| FitError::Replay { model: id.to_owned(), reason: e.to_string() })?;
     let replay_ns = t0.elapsed().as_secs_f64() * 1e9 / samples.len().max(1) as f64;
     let output: Vec<f64> = rep.y.iter().map(|v| f64::from(*v)).collect();
-    let dx = gradient(&input, data.dt);
-    let ddx = gradient(&dx, data.dt);
+    let dx = data.per_run(&input, |v| gradient(v, data.dt));
+    let ddx = data.per_run(&dx, |v| gradient(v, data.dt));
     let score = |rows: &[usize]| {
         let pick = |v: &[f64]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
         metrics(&pick(&data.output), &pick(&output), Some((&pick(&dx), &pick(&ddx))))
     };
-    // A delayed channel has no data for the first or last few samples: those are not scored.
-    let n = data.len();
-    let (lo, hi) = crate::models::alignment::covered(n, &[delay, delay_u]);
-    let unflagged: Vec<usize> = data.heldout_unflagged().into_iter().filter(|i| (lo..hi).contains(i)).collect();
-    let all_heldout: Vec<usize> = (data.train_end..n).filter(|&i| (lo..hi).contains(&i) && data.usable(i)).collect();
-    let rows: Vec<usize> = rows.into_iter().filter(|i| (lo..hi).contains(i)).collect();
+    // A delayed channel has no data for the first or last few samples of a run: those are not scored.
+    let ds = [delay, delay_u];
+    let unflagged = data.covered(&data.heldout_unflagged(), &ds);
+    let all_heldout = data.covered(&data.heldout_rows(), &ds);
+    let rows = data.covered(&rows, &ds);
     scored_parts(&rows, &all_heldout, (delay, delay_u), data.dt)?;
+    let runs = per_run_metrics(data, &rows, &all_heldout, &score);
     let named = ParamsFile::from_flat(id, None, &p32).map(|f| f.params).unwrap_or(Values::Flat(params.clone()));
     Ok(FitResult {
         model: id.to_owned(),
@@ -278,6 +284,7 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         free_params: sp.free().len() + operator::projected_count(sp.structure),
         state_bytes: info.state_bytes,
         held: rep.held,
+        runs,
         warnings,
         flat: params,
         rate_choice: sp.rate,
@@ -462,6 +469,7 @@ fn global_search(
 /// its delay in samples. For the closed-form models, where a fit costs one pass.
 fn scan_delay<T>(
     kin: &[model_core::Kin],
+    starts: &[usize],
     at: impl Fn(&[model_core::Kin]) -> Option<(T, f64)> + Sync,
 ) -> Option<(T, f64)>
 where
@@ -470,7 +478,7 @@ where
     let m = crate::models::alignment::MAX_DELAY_SAMPLES as i32;
     let fit_shifted = |d: f64| {
         let mut shifted = Vec::new();
-        crate::models::alignment::shift_kin(kin, d, 0.0, &mut shifted);
+        crate::models::alignment::shift_kin_runs(kin, d, 0.0, starts, &mut shifted);
         at(&shifted).map(|(r, c)| (r, c, d))
     };
     let mut grid: Vec<Option<(T, f64, f64)>> = (-m..=m).into_par_iter().map(|d| fit_shifted(f64::from(d))).collect();
@@ -533,6 +541,7 @@ mod tests {
             excluded: vec![false; n],
             unusable: Vec::new(),
             rates: None,
+            runs: Vec::new(),
         }
     }
 
