@@ -25,6 +25,26 @@ pub struct ReplayReport {
     pub measured: Vec<f64>,
     #[serde(skip)]
     pub model_output: Vec<f64>,
+    /// The input's rate and acceleration (central differences), for the metrics.
+    #[serde(skip)]
+    pub rates: (Vec<f64>, Vec<f64>),
+    /// The samples scored (`lo..hi`: a delayed channel leaves the ends unscored).
+    #[serde(skip)]
+    pub scored: (usize, usize),
+}
+
+/// The metrics of several replays (the runs of a dataset) pooled: every run's scored samples.
+pub fn pooled(reports: &[ReplayReport]) -> Result<Metrics, NoSamples> {
+    let (mut y, mut m, mut dx, mut ddx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for r in reports {
+        let (lo, hi) = r.scored;
+        let part = |v: &[f64]| v.get(lo..hi).unwrap_or(&[]).to_vec();
+        y.extend(part(&r.measured));
+        m.extend(part(&r.model_output));
+        dx.extend(part(&r.rates.0));
+        ddx.extend(part(&r.rates.1));
+    }
+    try_metrics(&y, &m, Some((&dx, &ddx)))
 }
 
 /// Replay `rec` through `model` with flat `params`, the input and the command read
@@ -65,6 +85,8 @@ pub fn replay_recording(
         time: t.to_vec(),
         measured: y.to_vec(),
         model_output,
+        rates: (dx, ddx),
+        scored: (lo, hi),
     })
 }
 
