@@ -56,6 +56,7 @@ fn one(
     pf: &ParamsFile,
     flat: &[f32],
     a: &ReplayArgs,
+    rate: hil_sim::models::RateSpec,
 ) -> anyhow::Result<(ReplayReport, quality::Quality)> {
     let mut rec = rec;
     super::list_skipped(a.ch.verbose, &rec);
@@ -70,11 +71,6 @@ fn one(
             );
         }
     }
-    let rate = match (a.ch.rate()?, pf.rate.as_deref()) {
-        (Some(r), _) => r,
-        (None, Some(r)) => super::parse_rate(r).with_context(|| format!("{}: `rate`", a.params.display()))?,
-        (None, None) => hil_sim::models::RateSpec::Backward,
-    };
     let q = quality::check(&rec, ch)?;
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
@@ -93,6 +89,11 @@ fn one(
 
 pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
     let pf = ParamsFile::read(&a.params)?;
+    let rate = match (a.ch.rate()?, pf.rate.as_deref()) {
+        (Some(r), _) => r,
+        (None, Some(r)) => super::parse_rate(r).with_context(|| format!("{}: `rate`", a.params.display()))?,
+        (None, None) => hil_sim::models::RateSpec::Backward,
+    };
     let flat = pf.flat(&a.params)?;
     let ch = channels(&a, &pf);
     if let (Some(f), None) = (&pf.channels, &ch.command) {
@@ -105,7 +106,7 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
     let mut qualities = Vec::with_capacity(specs.len());
     for s in &specs {
         let rec = Recording::read(&s.path)?;
-        let (r, q) = one(rec, &s.channels, &pf, &flat, &a)?;
+        let (r, q) = one(rec, &s.channels, &pf, &flat, &a, rate)?;
         reports.push(r);
         qualities.push(q);
     }
@@ -133,7 +134,11 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
     for (s, r) in specs.iter().zip(&reports) {
         super::emit(&format!("{} ({}): {}", s.path.display(), s.role.label(), line(&r.metrics, r.held)));
     }
-    super::emit(&format!("pooled over {} runs: {}", reports.len(), line(&metrics, reports.iter().map(|r| r.held).sum())));
+    super::emit(&format!(
+        "pooled over {} runs: {}",
+        reports.len(),
+        line(&metrics, reports.iter().map(|r| r.held).sum())
+    ));
     Ok(())
 }
 

@@ -16,6 +16,7 @@
 //!   from a replay through [`crate::models::replay()`] — the `Estimator` path, f32.
 
 pub mod global;
+pub mod identifiable;
 pub mod job;
 pub mod linear;
 pub mod lm;
@@ -24,6 +25,7 @@ pub mod narx_net;
 pub mod objective;
 pub mod operator;
 mod per_run;
+pub mod restarts;
 pub mod simulate;
 
 use std::time::Instant;
@@ -173,10 +175,42 @@ pub struct FitResult {
     pub output: Vec<f64>,
 }
 
-/// Fit model `id` to `data`.
+/// Fit model `id` to `data`. A fitted delay that ends at the edge of its search range is
+/// held at zero and the model refitted, with a warning ([`identifiable`]).
 pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, FitError> {
+    let first = fit_once(id, data, opts)?;
+    let dt = data.dt;
+    let (d, d_u) = (first.delay_s / dt, first.command_delay_s / dt);
+    let (edge_x, edge_u) = (identifiable::at_edge(d), identifiable::at_edge(d_u));
+    if opts.delay != DelayChoice::Auto || !(edge_x || edge_u) {
+        return Ok(first);
+    }
+    let mut which = Vec::new();
+    if edge_x {
+        which.push(("input", d));
+    }
+    if edge_u {
+        which.push(("command", d_u));
+    }
+    let held =
+        DelayChoice::Fixed(if edge_x { 0.0 } else { first.delay_s }, if edge_u { 0.0 } else { first.command_delay_s });
+    let mut r = fit_once(id, data, &FitOptions { delay: held, ..*opts })?;
+    r.warnings.insert(0, identifiable::edge_warning(&which, dt));
+    r.fit_seconds += first.fit_seconds;
+    r.evaluations += first.evaluations;
+    Ok(r)
+}
+
+/// [`fit`] without the check of the delays.
+fn fit_once(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, FitError> {
     let info = model_core::registry::find(id).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
-    let scales = data.scales();
+    // A command that never changes cannot identify the terms it drives: fit the model's
+    // no-command form (those terms held) and say so.
+    let constant_u = identifiable::constant_command(data);
+    let scales = match constant_u {
+        Some(_) => Scales { u: None, ..data.scales() },
+        None => data.scales(),
+    };
     let host = crate::models::host(id).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
     let sp = host.spec(&scales, opts.rate).ok_or_else(|| FitError::NotFittable(id.to_owned()))?;
     let started = Instant::now();
@@ -187,8 +221,9 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         .ok_or(FitError::RateOverflow { model: id.to_owned() })?;
     let sim = simulate::simulator_runs(id, dt, &starts).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
     let rows = data.train_rows();
+    let notes = restarts::Notes::default();
     let fit_at = |kin: &[model_core::Kin], sp: &ModelSpec| {
-        identify_variants(id, sp, sim.as_ref(), kin, &data.output, &rows, &scales, opts)
+        identify_variants(id, sp, sim.as_ref(), kin, &data.output, &rows, &scales, opts, &notes)
     };
     let n_model = sim.n_params();
     let ((mut params, evaluations), (delay, delay_u)) = match (opts.delay, sp.strategy) {
@@ -223,7 +258,11 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     };
     params.truncate(n_model);
     let fit_seconds = started.elapsed().as_secs_f64();
-    let mut warnings = Vec::new();
+    let mut warnings: Vec<String> = constant_u
+        .map(|v| identifiable::constant_command_warning(v, &identifiable::command_terms(id, &data.scales())))
+        .into_iter()
+        .collect();
+    warnings.extend(notes.into_inner().unwrap_or_default());
     if sp.structure == Structure::AsymmetricBoucWen {
         let mut shifted = Vec::new();
         crate::models::alignment::shift_kin_runs(&kin, delay, delay_u, &starts, &mut shifted);
@@ -311,6 +350,7 @@ fn identify_variants(
     rows: &[usize],
     scales: &Scales,
     opts: &FitOptions,
+    notes: &restarts::Notes,
 ) -> Result<(Vec<f64>, usize), FitError> {
     let mut best: Option<(Vec<f64>, usize, f64)> = None;
     let mut evals = 0;
@@ -318,7 +358,7 @@ fn identify_variants(
     let mut k = 0;
     let mut current = Some(sp.clone());
     while let Some(v) = current {
-        match identify(id, &v, sim, kin, y, rows, scales.y, opts) {
+        match identify(id, &v, sim, kin, y, rows, scales.y, opts, notes) {
             Ok((p, e)) => {
                 evals += e;
                 let cost = Objective::new(sim, &v, kin, y, rows, scales.y).cost(&p);
@@ -349,6 +389,7 @@ fn identify(
     rows: &[usize],
     y_scale: f64,
     opts: &FitOptions,
+    notes: &restarts::Notes,
 ) -> Result<(Vec<f64>, usize), FitError> {
     let full = Objective::new(sim, sp, kin, y, rows, y_scale);
     match sp.strategy {
@@ -388,7 +429,7 @@ fn identify(
                     (p.lo, p.hi, p.start) = (v, v, v);
                 }
             }
-            let (p, evals) = identify(id, &shape, &proj, kin, y, rows, y_scale, opts)?;
+            let (p, evals) = identify(id, &shape, &proj, kin, y, rows, y_scale, opts, notes)?;
             let full = proj.complete(&p, kin).ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
             valid_or_err(id, sim, full, evals)
         }
@@ -399,26 +440,47 @@ fn identify(
             // per weight per Jacobian) to a few seconds on the Dyke files; NARX has its own
             // ([`narx_net::Effort`]).
             let (iterations, window) = (3 * opts.lm_iterations.max(1), opts.swarm_window.min(6000));
-            let t = narx::train(sp.structure, kin, y, rows, 1e-3, sp.rate, iterations, window, opts.swarm.seed)
-                .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
-            valid_or_err(id, sim, t.params, t.evaluations)
+            let mut evals = 0;
+            let t = restarts::until_agree(&format!("the {id} training"), opts.swarm.seed, notes, |seed| {
+                let t = narx::train(sp.structure, kin, y, rows, 1e-3, sp.rate, iterations, window, seed)?;
+                evals += t.evaluations;
+                let cost = full.cost(&t.params);
+                Some((t.params, cost))
+            })
+            .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
+            valid_or_err(id, sim, t, evals)
         }
         Strategy::Global => {
             let window_rows: Vec<usize> = rows.iter().copied().filter(|&i| i < opts.swarm_window).collect();
             let window_rows = if window_rows.len() < 20 { rows.to_vec() } else { window_rows };
             let win = Objective::new(sim, sp, kin, y, &window_rows, y_scale);
-            let first = global_search(id, sp, &win, &full, opts, opts.swarm)?;
-            // A box where the small swarm found nothing valid (a start that is not a
-            // published set, a narrow valid region) gets a wider search before giving up.
-            let (best, mut evals) = match first {
-                (Some(best), evals) => (best, evals),
-                (None, evals) => {
-                    let wide = SwarmOptions::wide(opts.swarm.seed);
-                    match global_search(id, sp, &win, &full, opts, wide)? {
-                        (Some(best), more) => (best, evals + more),
-                        (None, _) => return Err(FitError::NoValidSet { model: id.to_owned() }),
+            let mut evals = 0;
+            let mut failure = None;
+            let best = restarts::until_agree(&format!("the {id} global search"), opts.swarm.seed, notes, |seed| {
+                let swarm = SwarmOptions { seed, ..opts.swarm };
+                let r = global_search(id, sp, &win, &full, opts, swarm).and_then(|first| match first {
+                    (Some(best), e) => Ok((Some(best), e)),
+                    // A box where the small swarm found nothing valid (a start that is not a
+                    // published set, a narrow valid region) gets a wider search before giving up.
+                    (None, e) => global_search(id, sp, &win, &full, opts, SwarmOptions::wide(seed))
+                        .map(|(b, more)| (b, e + more)),
+                });
+                match r {
+                    Ok((b, e)) => {
+                        evals += e;
+                        b.map(|b| {
+                            let c = b.cost;
+                            (b, c)
+                        })
+                    }
+                    Err(e) => {
+                        failure = failure.take().or(Some(e));
+                        None
                     }
                 }
+            });
+            let Some(best) = best else {
+                return Err(failure.unwrap_or_else(|| FitError::NoValidSet { model: id.to_owned() }));
             };
             let r = lm::minimize(&full, &best.params, opts.lm_iterations);
             evals += r.evaluations;
@@ -513,76 +575,4 @@ fn valid_or_err(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::models::replay;
-
-    /// A recording of `id` with `truth`, whose input channel was logged `lag` samples late.
-    fn lagged(id: &str, truth: &[f32], lag: f64, command: bool) -> Dataset {
-        let dt = 1e-3;
-        let n = 6000;
-        let time: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
-        let x_true: Vec<f64> = time
-            .iter()
-            .map(|t| (2.0 * std::f64::consts::PI * 3.0 * t).sin() + 0.4 * (2.0 * std::f64::consts::PI * 11.0 * t).sin())
-            .collect();
-        let u = command.then(|| time.iter().map(|t| 1.0 + 0.8 * (3.1 * t).sin()).collect::<Vec<f64>>());
-        let samples = crate::models::replay::samples(&x_true, u.as_deref());
-        let out = replay(id, truth, dt as f32, RateSpec::Backward, &samples).unwrap();
-        // The logged input is the true one `lag` samples late: x_log(t) = x_true(t − lag).
-        let input = crate::models::alignment::shift(&x_true, -lag);
-        Dataset {
-            dt,
-            time,
-            input,
-            output: out.y.iter().map(|v| f64::from(*v)).collect(),
-            command: u,
-            train_end: 4200,
-            excluded: vec![false; n],
-            unusable: Vec::new(),
-            rates: None,
-            runs: Vec::new(),
-        }
-    }
-
-    fn opts(delay: DelayChoice) -> FitOptions {
-        // Noiseless data: let Levenberg–Marquardt run to convergence.
-        FitOptions {
-            rate: Some(RateSpec::Backward),
-            delay,
-            lm_iterations: 80,
-            polish_iterations: 80,
-            ..FitOptions::default()
-        }
-    }
-
-    #[test]
-    fn closed_form_fit_finds_a_known_input_delay() {
-        let data = lagged("algebraic", &[2.0, 0.05, -0.3, 0.1], 3.0, false);
-        let auto = fit("algebraic", &data, &opts(DelayChoice::Auto)).unwrap();
-        let off = fit("algebraic", &data, &opts(DelayChoice::Off)).unwrap();
-        assert!((auto.delay_s - 3e-3).abs() < 0.3e-3, "delay {} s", auto.delay_s);
-        assert_eq!(off.delay_s, 0.0);
-        assert!(auto.heldout.rmse < 1e-3 * off.heldout.rmse, "{} vs {}", auto.heldout.rmse, off.heldout.rmse);
-    }
-
-    #[test]
-    fn iterative_fit_finds_a_known_input_delay() {
-        let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
-        let data = lagged("bouc_wen", &truth, -2.5, false);
-        let auto = fit("bouc_wen", &data, &opts(DelayChoice::Auto)).unwrap();
-        let off = fit("bouc_wen", &data, &opts(DelayChoice::Off)).unwrap();
-        assert!(
-            (auto.delay_s + 2.5e-3).abs() < 0.5e-3,
-            "delay {} s, rmse {} vs {}",
-            auto.delay_s,
-            auto.train.rmse,
-            off.train.rmse
-        );
-        assert_eq!(auto.command_delay_s, 0.0, "no command channel, no command delay");
-        assert!(auto.train.rmse < off.train.rmse, "{} vs {}", auto.train.rmse, off.train.rmse);
-        // A given delay is used as given.
-        let fixed = fit("bouc_wen", &data, &opts(DelayChoice::Fixed(-2.5e-3, 0.0))).unwrap();
-        assert!((fixed.delay_s + 2.5e-3).abs() < 1e-12);
-    }
-}
+mod tests;

@@ -47,8 +47,7 @@ impl Dialect {
 /// become points (any comma inside a field, since commas do not separate in these dialects).
 pub fn to_csv(text: &str, dialect: Dialect) -> String {
     let mut out = String::with_capacity(text.len());
-    for line in text.split('\n') {
-        let line = line.strip_suffix('\r').unwrap_or(line);
+    for line in text.lines() {
         let fields: Vec<&str> = match dialect {
             Dialect::Comma => vec![line],
             Dialect::Semicolon => line.split(';').collect(),
@@ -80,7 +79,7 @@ mod tests {
         assert_eq!(Dialect::sniff("\n t\tb\n"), Dialect::Tab);
         assert_eq!(Dialect::sniff("t  b\n"), Dialect::Space);
         assert_eq!(Dialect::sniff("\"t\",\"b\",\n"), Dialect::Comma);
-        assert_eq!(to_csv("t;b\r\n0,5;1,25\r\n", Dialect::Semicolon), "t,b\n0.5,1.25\n\n");
+        assert_eq!(to_csv("t;b\r\n0,5;1,25\r\n", Dialect::Semicolon), "t,b\n0.5,1.25\n");
         assert_eq!(to_csv("  0.0  -1.4e-3\n", Dialect::Space), "0.0,-1.4e-3\n");
     }
 }

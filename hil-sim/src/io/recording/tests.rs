@@ -82,13 +82,19 @@ fn mat_errors_name_file_variable_and_sample() {
     let msg = |n: &str| Recording::read(&corpus(n)).unwrap_err().to_string();
     let m = msg("truncated.mat");
     assert!(m.contains("truncated.mat") && m.contains("truncated MAT-file"), "{m}");
-    let m = msg("matrix_shape.mat");
-    assert!(m.contains("variable `torque` is a 3×4 matrix"), "{m}");
-    let m = msg("length_mismatch.mat");
+    // A variable that cannot be a channel is skipped; asking for it gives the reason.
+    let used = |n: &str, var: &str| {
+        let r = Recording::read(&corpus(n)).unwrap();
+        assert!(r.channel("t").is_ok() && r.skipped.iter().any(|s| s.name == var), "{n}: {:?}", r.skipped);
+        r.channel(var).unwrap_err().to_string()
+    };
+    let m = used("matrix_shape.mat", "torque");
+    assert!(m.contains("variable `torque` is a 3×4 matrix") && m.contains("`torque:K`"), "{m}");
+    let m = used("length_mismatch.mat", "torque");
     assert!(m.contains("variable `torque` has 40 samples but `t` has 50"), "{m}");
-    let m = msg("nan.mat");
+    let m = used("nan.mat", "torque");
     assert!(m.contains("variable `torque`, sample 17: value is NaN"), "{m}");
-    let m = msg("char_variable.mat");
+    let m = used("char_variable.mat", "notes");
     assert!(m.contains("variable `notes` is a char array"), "{m}");
     let m = msg("garbage.bin");
     assert!(m.contains("garbage.bin") && m.contains("binary data"), "{m}");
