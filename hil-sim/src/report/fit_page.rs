@@ -39,6 +39,7 @@ pub fn write(
         data.len() - data.train_end
     ));
     results_table(&mut rep, results);
+    super::runs::section(&mut rep, data, results);
     let stem = |m: &str| format!("fit_{m}");
     error_bars(&mut rep, dir, "fit", results)?;
     if let Some(best) = results.iter().min_by(|x, y| x.heldout.rmse.total_cmp(&y.heldout.rmse)) {

@@ -17,6 +17,7 @@ pub mod diagnose;
 pub mod fit;
 pub mod fit_page;
 pub mod plot;
+pub mod runs;
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};

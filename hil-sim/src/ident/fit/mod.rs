@@ -441,7 +441,10 @@ fn identify(
             // ([`narx_net::Effort`]).
             let (iterations, window) = (3 * opts.lm_iterations.max(1), opts.swarm_window.min(6000));
             let mut evals = 0;
-            let t = restarts::until_agree(&format!("the {id} training"), opts.swarm.seed, notes, |seed| {
+            // Hammerstein–Wiener's training depends on its random start (seed 1 and 2 can end
+            // far apart); NARX's own effort schedule is kept to one start for its cost.
+            let starts = if sp.structure == Structure::HammersteinWiener { restarts::MAX_STARTS } else { 1 };
+            let t = restarts::until_agree(&format!("the {id} training"), opts.swarm.seed, starts, notes, |seed| {
                 let t = narx::train(sp.structure, kin, y, rows, 1e-3, sp.rate, iterations, window, seed)?;
                 evals += t.evaluations;
                 let cost = full.cost(&t.params);
@@ -456,29 +459,35 @@ fn identify(
             let win = Objective::new(sim, sp, kin, y, &window_rows, y_scale);
             let mut evals = 0;
             let mut failure = None;
-            let best = restarts::until_agree(&format!("the {id} global search"), opts.swarm.seed, notes, |seed| {
-                let swarm = SwarmOptions { seed, ..opts.swarm };
-                let r = global_search(id, sp, &win, &full, opts, swarm).and_then(|first| match first {
-                    (Some(best), e) => Ok((Some(best), e)),
-                    // A box where the small swarm found nothing valid (a start that is not a
-                    // published set, a narrow valid region) gets a wider search before giving up.
-                    (None, e) => global_search(id, sp, &win, &full, opts, SwarmOptions::wide(seed))
-                        .map(|(b, more)| (b, e + more)),
-                });
-                match r {
-                    Ok((b, e)) => {
-                        evals += e;
-                        b.map(|b| {
-                            let c = b.cost;
-                            (b, c)
-                        })
+            let best = restarts::until_agree(
+                &format!("the {id} global search"),
+                opts.swarm.seed,
+                restarts::MAX_STARTS,
+                notes,
+                |seed| {
+                    let swarm = SwarmOptions { seed, ..opts.swarm };
+                    let r = global_search(id, sp, &win, &full, opts, swarm).and_then(|first| match first {
+                        (Some(best), e) => Ok((Some(best), e)),
+                        // A box where the small swarm found nothing valid (a start that is not a
+                        // published set, a narrow valid region) gets a wider search before giving up.
+                        (None, e) => global_search(id, sp, &win, &full, opts, SwarmOptions::wide(seed))
+                            .map(|(b, more)| (b, e + more)),
+                    });
+                    match r {
+                        Ok((b, e)) => {
+                            evals += e;
+                            b.map(|b| {
+                                let c = b.cost;
+                                (b, c)
+                            })
+                        }
+                        Err(e) => {
+                            failure = failure.take().or(Some(e));
+                            None
+                        }
                     }
-                    Err(e) => {
-                        failure = failure.take().or(Some(e));
-                        None
-                    }
-                }
-            });
+                },
+            );
             let Some(best) = best else {
                 return Err(failure.unwrap_or_else(|| FitError::NoValidSet { model: id.to_owned() }));
             };
