@@ -31,8 +31,8 @@ pub enum RunsError {
     Manifest(#[from] ManifestError),
     #[error("{}: sampled every {dt} s but {} every {first} s; the runs of a dataset share one step", path.display(), first_path.display())]
     Step { path: PathBuf, dt: f64, first_path: PathBuf, first: f64 },
-    #[error("{}: has a command channel `{name}` but {} has none", with.display(), without.display())]
-    Command { name: String, with: PathBuf, without: PathBuf },
+    #[error("{}: has a command channel but {} has none; the runs of a dataset share their channels", with.display(), without.display())]
+    Command { with: PathBuf, without: PathBuf },
 }
 
 /// The runs of a manifest, with `ch` (the command line's channels) under its `[channels]`.
@@ -77,31 +77,32 @@ pub struct PreparedRuns {
 pub fn prepare_runs(specs: &[RunSpec], train: f64, keep_flagged: bool) -> Result<PreparedRuns, RunsError> {
     let mut runs = Vec::with_capacity(specs.len());
     for s in specs {
-        runs.push(prepare(&s.path, &s.channels, train, keep_flagged)?);
+        runs.push((prepare(&s.path, &s.channels, train, keep_flagged)?, s.role));
     }
+    join_prepared(runs)
+}
+
+/// Join runs already prepared (e.g. from [`crate::ident::dataset::prepare_recording`]), each
+/// with its role.
+pub fn join_prepared(runs: Vec<(Prepared, Role)>) -> Result<PreparedRuns, RunsError> {
+    let (runs, roles): (Vec<Prepared>, Vec<Role>) = runs.into_iter().unzip();
     if let [one] = runs.as_slice() {
         return Ok(PreparedRuns { joined: one.clone(), runs });
     }
     let first = runs.first().ok_or(DatasetError::NoHeldOut)?;
-    for (s, r) in specs.iter().zip(&runs).skip(1) {
+    let path = |r: &Prepared| r.recording.path.clone();
+    for r in runs.iter().skip(1) {
         let (dt, first_dt) = (r.data.dt, first.data.dt);
         if (dt - first_dt).abs() > 0.01 * first_dt {
-            return Err(RunsError::Step {
-                path: s.path.clone(),
-                dt,
-                first_path: specs[0].path.clone(),
-                first: first_dt,
-            });
+            return Err(RunsError::Step { path: path(r), dt, first_path: path(first), first: first_dt });
         }
         if r.data.command.is_some() != first.data.command.is_some() {
-            let (with, without) =
-                if first.data.command.is_some() { (&specs[0].path, &s.path) } else { (&s.path, &specs[0].path) };
-            let name = specs[0].channels.command.clone().or_else(|| s.channels.command.clone()).unwrap_or_default();
-            return Err(RunsError::Command { name, with: with.clone(), without: without.clone() });
+            let (with, without) = if first.data.command.is_some() { (first, r) } else { (r, first) };
+            return Err(RunsError::Command { with: path(with), without: path(without) });
         }
     }
-    let any_validate = specs.iter().any(|s| s.role == Role::Validate);
-    let joined = join(specs, &runs, any_validate);
+    let any_validate = roles.contains(&Role::Validate);
+    let joined = join(&runs, &roles, any_validate);
     let mut quality =
         Quality { warnings: Vec::new(), samples: 0, excluded_samples: 0, notes: Vec::new(), unusable: Vec::new() };
     for (r, span) in runs.iter().zip(&joined.runs) {
@@ -121,7 +122,7 @@ pub fn prepare_runs(specs: &[RunSpec], train: f64, keep_flagged: bool) -> Result
 }
 
 /// The runs' data end to end (time made to continue, one step after the previous run).
-fn join(specs: &[RunSpec], runs: &[Prepared], any_validate: bool) -> Dataset {
+fn join(runs: &[Prepared], roles: &[Role], any_validate: bool) -> Dataset {
     let first = &runs[0].data;
     let mut d = Dataset {
         dt: first.dt,
@@ -136,7 +137,7 @@ fn join(specs: &[RunSpec], runs: &[Prepared], any_validate: bool) -> Dataset {
         runs: Vec::new(),
     };
     let mut offset_t = 0.0;
-    for (s, r) in specs.iter().zip(runs) {
+    for (r, role) in runs.iter().zip(roles) {
         let (data, start) = (&r.data, d.len());
         let t0 = data.time.first().copied().unwrap_or(0.0);
         d.time.extend(data.time.iter().map(|t| t - t0 + offset_t));
@@ -149,12 +150,12 @@ fn join(specs: &[RunSpec], runs: &[Prepared], any_validate: bool) -> Dataset {
         d.excluded.extend_from_slice(&data.excluded);
         d.unusable.extend(data.unusable.iter().map(|i| i + start));
         let end = d.len();
-        let train_end = match (any_validate, s.role) {
+        let train_end = match (any_validate, role) {
             (false, _) => start + data.train_end,
             (true, Role::Train) => end,
             (true, Role::Validate) => start,
         };
-        d.runs.push(RunSpan { file: s.path.clone(), role: s.role, start, train_end, end });
+        d.runs.push(RunSpan { file: r.recording.path.clone(), role: *role, start, train_end, end });
     }
     // The one split a plot can mark: where the held-out runs begin, or the last run's split.
     d.train_end = d

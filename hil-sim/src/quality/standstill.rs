@@ -73,10 +73,10 @@ fn still(t: &[f64], v: &[f64], band: f64, min_s: f64) -> Vec<bool> {
 
 /// The input at rest, wherever it is (at the start, between tests, at the end), is a
 /// standstill — not a clipped minimum or a dropout. An input clipping or hold episode is one
-/// when it touches either end of the recording or when the output stays quiet through it
-/// (within `standstill_output_band` of its span: a real dropout or a clipped sensor leaves the
-/// device, and so the output, moving). Such warnings become standstill warnings, and a hold
-/// of the output inside an input standstill is dropped.
+/// when the output stays quiet through it (within `standstill_output_band` of its span: a real
+/// dropout or a clipped sensor leaves the device, and so the output, moving; an end stop
+/// pushes back). Such warnings become standstill warnings, and a hold
+/// or a flat extreme of another channel inside an input standstill is dropped.
 pub(super) fn reclassify(ctx: &Ctx, input: &str, x: &[f64], y: &[f64], found: &mut Vec<Warning>, cfg: &QualityConfig) {
     let n = x.len();
     let (ylo, yhi) = min_max(y);
@@ -91,7 +91,7 @@ pub(super) fn reclassify(ctx: &Ctx, input: &str, x: &[f64], y: &[f64], found: &m
     found.retain(|w| {
         let candidate = w.channel == input && matches!(w.kind, WarningKind::Clipped | WarningKind::Dropout);
         let (a, b) = (w.first_index, w.last_index.min(n.saturating_sub(1)));
-        if !candidate || !(a == 0 || b + 1 >= n || quiet(a, b)) {
+        if !candidate || !quiet(a, b) {
             return true;
         }
         let (lo, hi) = min_max(x.get(a..=b).unwrap_or(&[]));
@@ -111,7 +111,7 @@ pub(super) fn reclassify(ctx: &Ctx, input: &str, x: &[f64], y: &[f64], found: &m
         rest.push(ctx.warning(WarningKind::Standstill, input, a, b, what));
         false
     });
-    // Holds of other channels inside a standstill are the rest too.
+    // Holds and flat extremes of the other channels inside a standstill are the rest too.
     let stills: Vec<(usize, usize)> = found
         .iter()
         .chain(&rest)
@@ -119,7 +119,8 @@ pub(super) fn reclassify(ctx: &Ctx, input: &str, x: &[f64], y: &[f64], found: &m
         .map(|w| (w.first_index, w.last_index))
         .collect();
     found.retain(|w| {
-        w.kind != WarningKind::Dropout || !stills.iter().any(|&(a, b)| a <= w.first_index && w.last_index <= b)
+        let at_rest = matches!(w.kind, WarningKind::Dropout | WarningKind::Clipped) && w.channel != input;
+        !at_rest || !stills.iter().any(|&(a, b)| a <= w.first_index && w.last_index <= b)
     });
     found.extend(rest);
 }

@@ -35,11 +35,16 @@ impl Channels {
 
 impl Recording {
     /// Turn the constants `ch` gives (`ch.set`), and the file's own constants a role names,
-    /// into full-length channels. A given constant may not shadow a channel of the file.
+    /// into full-length channels. A given constant may not shadow a channel of the file (applying
+    /// the same constants again changes nothing).
     pub fn apply_constants(&mut self, ch: &Channels) -> Result<(), RecordingError> {
         let n = self.len();
         for (name, v) in &ch.set {
-            if self.columns.iter().any(|c| &c.name == name) {
+            if let Some(c) = self.columns.iter().find(|c| &c.name == name) {
+                // Applied before (the same constant): nothing to do.
+                if c.values.iter().all(|x| x == v) {
+                    continue;
+                }
                 return Err(RecordingError::SetShadows { path: self.path.clone(), name: name.clone() });
             }
             self.constants.retain(|c| &c.0 != name);
