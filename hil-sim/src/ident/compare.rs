@@ -177,7 +177,7 @@ fn on_own_runs(
             .map_err(|e| FitError::Replay { model: id.to_owned(), reason: e.to_string() })?;
         avg.push(rep.y.iter().map(|v| f64::from(*v)).collect::<Vec<f64>>());
     }
-    let parts: Vec<(&[f64], &[f64], &[f64], Vec<usize>)> = identify
+    let parts: Vec<own_runs::Part<'_>> = identify
         .iter()
         .zip(fits)
         .zip(&avg)

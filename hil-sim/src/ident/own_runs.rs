@@ -29,9 +29,13 @@ const BLOCKS: usize = 20;
 /// Standard errors above zero that are not chance.
 const Z_LIMIT: f64 = 3.0;
 
+/// One recording's part of the check: measured output, its own fit's output, the averaged
+/// set's output, and the samples to compare on.
+pub type Part<'a> = (&'a [f64], &'a [f64], &'a [f64], Vec<usize>);
+
 /// Compare, per recording, the residuals of the averaged set (`avg`) and of the recording's
 /// own fit (`own`) against the measured `y`, on `rows`. Each item is `(y, own, avg, rows)`.
-pub fn check(parts: &[(&[f64], &[f64], &[f64], Vec<usize>)]) -> Option<OwnRunsCheck> {
+pub fn check(parts: &[Part<'_>]) -> Option<OwnRunsCheck> {
     let (mut sa, mut so, mut n) = (0.0, 0.0, 0usize);
     let mut blocks = Vec::new();
     for (y, own, avg, rows) in parts {

@@ -61,7 +61,7 @@ pub enum FitJobError {
     #[error(transparent)]
     Runs(RunsError),
     #[error("fitting `{model}`")]
-    Fit { model: String, source: FitError },
+    Fit { model: String, source: Box<FitError> },
     #[error("{}: {reason}", path.display())]
     Save { path: PathBuf, reason: String },
 }
@@ -77,7 +77,9 @@ pub fn fit_many(
     let mut out = Vec::with_capacity(ids.len());
     for id in ids {
         progress.message(id);
-        out.push(fit(id, data, opts).map_err(|source| FitJobError::Fit { model: id.clone(), source })?);
+        out.push(
+            fit(id, data, opts).map_err(|source| FitJobError::Fit { model: id.clone(), source: Box::new(source) })?,
+        );
         progress.advance(1);
     }
     Ok(out)

@@ -264,15 +264,7 @@ fn fit_once(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fi
         .collect();
     warnings.extend(notes.into_inner().unwrap_or_default());
     if sp.structure == Structure::AsymmetricBoucWen {
-        let mut shifted = Vec::new();
-        crate::models::alignment::shift_kin_runs(&kin, delay, delay_u, &starts, &mut shifted);
-        if operator::abw_crossing(&params, dt, &shifted, &rows) == Some(true) {
-            let eq = if params.get(11).copied() == Some(1.0) { "eq. 30" } else { "eq. 31" };
-            warnings.push(format!(
-                "bouc_wen_asym ({eq}): the fitted loop crosses itself over the training range at the data's mean \
-                 rate, a non-physical artefact (seed 004 §6.2); do not use this set for control"
-            ));
-        }
+        warnings.extend(abw_warning(&params, dt, &kin, (delay, delay_u), &starts, &rows));
     }
 
     // Score with the Estimator path, the firmware's code, over the whole recording.
@@ -328,6 +320,26 @@ fn fit_once(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fi
         flat: params,
         rate_choice: sp.rate,
         output,
+    })
+}
+
+/// The asymmetric Bouc–Wen set's non-physical crossing loop (seed 004 §6.2), if it has one.
+fn abw_warning(
+    params: &[f64],
+    dt: f32,
+    kin: &[model_core::Kin],
+    delays: (f64, f64),
+    starts: &[usize],
+    rows: &[usize],
+) -> Option<String> {
+    let mut shifted = Vec::new();
+    crate::models::alignment::shift_kin_runs(kin, delays.0, delays.1, starts, &mut shifted);
+    (operator::abw_crossing(params, dt, &shifted, rows) == Some(true)).then(|| {
+        let eq = if params.get(11).copied() == Some(1.0) { "eq. 30" } else { "eq. 31" };
+        format!(
+            "bouc_wen_asym ({eq}): the fitted loop crosses itself over the training range at the data's mean \
+             rate, a non-physical artefact (seed 004 §6.2); do not use this set for control"
+        )
     })
 }
 

@@ -10,7 +10,7 @@
 use std::io::Read;
 use std::path::Path;
 
-use super::{Recording, RecordingError};
+use super::RecordingError;
 
 /// What reading a MAT-file may hold in memory beyond the file itself (bytes): 64 MiB and
 /// four times the file's size, for the inflated elements and the values read as f64.
@@ -404,16 +404,14 @@ pub(super) fn shape(dims: &[u64]) -> String {
     dims.iter().map(u64::to_string).collect::<Vec<_>>().join("×")
 }
 
-/// Parse level-5 MAT bytes; `path` is used in messages only. Which variables become
-/// channels is decided in [`super::variables`].
-pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Recording, RecordingError> {
+/// The variables of level-5 MAT bytes, in file order; `path` is used in messages only.
+pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<Vec<Variable>, RecordingError> {
     let p = || path.to_path_buf();
     if bytes.is_empty() {
         return Err(RecordingError::Empty { path: p() });
     }
-    let vars = variables(bytes).map_err(|f| match f {
+    variables(bytes).map_err(|f| match f {
         Fault::Truncated(offset) => RecordingError::MatTruncated { path: p(), offset, size: bytes.len() },
         Fault::Format(reason) => RecordingError::MatFormat { path: p(), reason },
-    })?;
-    super::variables::recording(path, vars)
+    })
 }

@@ -142,7 +142,7 @@ impl Recording {
     /// Parse level-5 MAT-file bytes: one numeric vector per channel (all the same
     /// length), a scalar variable becomes a constant; `path` is used in messages only.
     pub fn parse_mat(path: &Path, bytes: &[u8]) -> Result<Self, RecordingError> {
-        mat::parse(path, bytes)
+        variables::recording(path, mat::read(path, bytes)?)
     }
 
     /// A recording made in memory (synthetic signals, tests): `columns` must be equally

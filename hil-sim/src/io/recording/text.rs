@@ -114,6 +114,23 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Recording, RecordingErr
     if rows == 0 {
         return Err(RecordingError::HeaderOnly { path: p() });
     }
+    let (columns, constants) = columns(path, names, raw, &lines)?;
+    if rows < 3 {
+        return Err(RecordingError::TooShort { path: p(), rows });
+    }
+    Ok(Recording { path: p(), columns, constants, lines, format: Format::Csv, skipped: Vec::new() })
+}
+
+/// The parsed fields as channels and constants (a column filled on its first row only); an
+/// unnamed column left empty is a trailing separator.
+#[allow(clippy::type_complexity)]
+fn columns(
+    path: &Path,
+    names: Vec<String>,
+    raw: Vec<Vec<Option<f64>>>,
+    lines: &[u64],
+) -> Result<(Vec<Column>, Vec<(String, f64)>), RecordingError> {
+    let rows = lines.len();
     let mut columns = Vec::new();
     let mut constants = Vec::new();
     for (name, col) in names.into_iter().zip(raw) {
@@ -127,17 +144,14 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Recording, RecordingErr
         }
         if let Some(missing) = col.iter().position(Option::is_none) {
             return Err(RecordingError::MissingValue {
-                path: p(),
+                path: path.to_path_buf(),
                 line: lines.get(missing).copied().unwrap_or(0),
                 column: if name.is_empty() { format!("#{}", columns.len() + 1) } else { shown(&name) },
             });
         }
         columns.push(Column { name, values: col.into_iter().flatten().collect() });
     }
-    if rows < 3 {
-        return Err(RecordingError::TooShort { path: p(), rows });
-    }
-    Ok(Recording { path: p(), columns, constants, lines, format: Format::Csv, skipped: Vec::new() })
+    Ok((columns, constants))
 }
 
 /// What to add to a "not a number" message: the dialect the file was read in, or the
