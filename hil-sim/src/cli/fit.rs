@@ -130,14 +130,16 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
         eprintln!("report written to {}", index.display());
     }
     let best = run.best().map(|r| r.model.clone());
+    // Samples in training parts (all of a dataset's runs; `train_end` for one recording).
+    let train_samples: usize = data.spans().iter().map(|r| r.train_end - r.start).sum();
     if a.json {
         return super::print_json(&json!({
             "recording": label,
             "samples": data.len(),
             "dt_s": data.dt,
             "train_fraction": a.train,
-            "train_samples": data.train_end,
-            "heldout_samples": data.len() - data.train_end,
+            "train_samples": train_samples,
+            "heldout_samples": data.len() - train_samples,
             "warnings": q.warnings,
             "notes": q.notes,
             "excluded_samples": if a.ch.keep_flagged { 0 } else { q.excluded_samples },
