@@ -15,6 +15,7 @@
 //! - [`fit`] returns the parameters and all metrics of the contract, train and held-out,
 //!   from a replay through [`crate::models::replay()`] — the `Estimator` path, f32.
 
+pub mod confidence;
 pub mod global;
 pub mod identifiable;
 pub mod job;
@@ -265,6 +266,10 @@ fn fit_once(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fi
     warnings.extend(notes.into_inner().unwrap_or_default());
     if sp.structure == Structure::AsymmetricBoucWen {
         warnings.extend(abw_warning(&params, dt, &kin, (delay, delay_u), &starts, &rows));
+    }
+    if matches!(sp.strategy, Strategy::Global | Strategy::Local) {
+        let (y, ds) = (&data.output, (delay, delay_u));
+        warnings.extend(confidence::check(sim.as_ref(), &sp, &kin, y, &rows, scales.y, ds, &starts, &params));
     }
 
     // Score with the Estimator path, the firmware's code, over the whole recording.
