@@ -40,6 +40,11 @@ pub fn constant_command_warning(value: f64, terms: &[&str]) -> String {
     format!("the command never changes over the training data (always {value}): {held}no command delay is fitted")
 }
 
+/// The warning for model `id` on `data` when its command is the constant `value` (`None`: it changes).
+pub fn constant_command_note(id: &str, data: &Dataset, value: Option<f64>) -> Option<String> {
+    value.map(|v| constant_command_warning(v, &command_terms(id, &data.scales())))
+}
+
 /// Whether a delay of `d` samples sits at the edge of the search range.
 pub fn at_edge(d: f64) -> bool {
     d.abs() >= MAX_DELAY_SAMPLES - 0.25

@@ -208,10 +208,7 @@ fn fit_once(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fi
     // A command that never changes cannot identify the terms it drives: fit the model's
     // no-command form (those terms held) and say so.
     let constant_u = identifiable::constant_command(data);
-    let scales = match constant_u {
-        Some(_) => Scales { u: None, ..data.scales() },
-        None => data.scales(),
-    };
+    let scales = Scales { u: data.scales().u.filter(|_| constant_u.is_none()), ..data.scales() };
     let host = crate::models::host(id).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
     let sp = host.spec(&scales, opts.rate).ok_or_else(|| FitError::NotFittable(id.to_owned()))?;
     let started = Instant::now();
@@ -259,31 +256,29 @@ fn fit_once(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fi
     };
     params.truncate(n_model);
     let fit_seconds = started.elapsed().as_secs_f64();
-    let mut warnings: Vec<String> = constant_u
-        .map(|v| identifiable::constant_command_warning(v, &identifiable::command_terms(id, &data.scales())))
-        .into_iter()
-        .collect();
+    let mut warnings: Vec<String> = identifiable::constant_command_note(id, data, constant_u).into_iter().collect();
     warnings.extend(notes.into_inner().unwrap_or_default());
+    let ds = (delay, delay_u);
     if sp.structure == Structure::AsymmetricBoucWen {
-        warnings.extend(abw_warning(&params, dt, &kin, (delay, delay_u), &starts, &rows));
+        warnings.extend(operator::abw_warning(&params, dt, &kin, ds, &starts, &rows));
     }
     if matches!(sp.strategy, Strategy::Global | Strategy::Local) {
-        let (y, ds) = (&data.output, (delay, delay_u));
-        warnings.extend(confidence::check(sim.as_ref(), &sp, &kin, y, &rows, scales.y, ds, &starts, &params));
+        warnings.extend(confidence::check(
+            sim.as_ref(),
+            &sp,
+            &kin,
+            &data.output,
+            &rows,
+            scales.y,
+            ds,
+            &starts,
+            &params,
+        ));
     }
 
     // Score with the Estimator path, the firmware's code, over the whole recording.
     let p32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
-    // The channels as the model saw them (as recorded when no delay was fitted).
-    let shift = |v: &[f64], d: f64| crate::models::alignment::shift_runs(v, d, &starts);
-    let input = shift(&data.input, delay);
-    let command = data.command.as_deref().map(|u| shift(u, delay_u));
-    let samples = if delay == 0.0 && delay_u == 0.0 {
-        samples
-    } else {
-        let rates = data.rates.as_ref().map(|(dx, ddx)| (shift(dx, delay), shift(ddx, delay)));
-        crate::models::replay::samples_with_rates(&input, command.as_deref(), rates.as_ref())
-    };
+    let (input, samples) = as_seen(data, samples, (delay, delay_u), &starts);
     let t0 = Instant::now();
     let rep = crate::models::replay::replay_runs(id, &p32, dt, sp.rate, &samples, &starts)
         .map_err(|e| FitError::Replay { model: id.to_owned(), reason: e.to_string() })?;
@@ -328,24 +323,23 @@ fn fit_once(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fi
     })
 }
 
-/// The asymmetric Bouc–Wen set's non-physical crossing loop (seed 004 §6.2), if it has one.
-fn abw_warning(
-    params: &[f64],
-    dt: f32,
-    kin: &[model_core::Kin],
-    delays: (f64, f64),
+/// The input and the samples as the model saw them: shifted by the fitted delays within each
+/// run (`samples`, as recorded, when there are none).
+fn as_seen(
+    data: &Dataset,
+    samples: Vec<model_core::Sample>,
+    (delay, delay_u): (f64, f64),
     starts: &[usize],
-    rows: &[usize],
-) -> Option<String> {
-    let mut shifted = Vec::new();
-    crate::models::alignment::shift_kin_runs(kin, delays.0, delays.1, starts, &mut shifted);
-    (operator::abw_crossing(params, dt, &shifted, rows) == Some(true)).then(|| {
-        let eq = if params.get(11).copied() == Some(1.0) { "eq. 30" } else { "eq. 31" };
-        format!(
-            "bouc_wen_asym ({eq}): the fitted loop crosses itself over the training range at the data's mean \
-             rate, a non-physical artefact (seed 004 §6.2); do not use this set for control"
-        )
-    })
+) -> (Vec<f64>, Vec<model_core::Sample>) {
+    let shift = |v: &[f64], d: f64| crate::models::alignment::shift_runs(v, d, starts);
+    let input = shift(&data.input, delay);
+    if delay == 0.0 && delay_u == 0.0 {
+        return (input, samples);
+    }
+    let command = data.command.as_deref().map(|u| shift(u, delay_u));
+    let rates = data.rates.as_ref().map(|(dx, ddx)| (shift(dx, delay), shift(ddx, delay)));
+    let samples = crate::models::replay::samples_with_rates(&input, command.as_deref(), rates.as_ref());
+    (input, samples)
 }
 
 /// Whether model `id` has a command-dependent parameter the fit frees (its spec fixes more
