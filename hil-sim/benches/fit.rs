@@ -19,7 +19,13 @@ fn dyke(train: f64, take: Option<usize>) -> Dataset {
         }
         rec.lines.truncate(n);
     }
-    let ch = Channels { time: "t".into(), input: "D".into(), output: "F".into(), command: Some("Y".into()) };
+    let ch = Channels {
+        time: "t".into(),
+        input: "D".into(),
+        output: "F".into(),
+        command: Some("Y".into()),
+        set: Vec::new(),
+    };
     Dataset::new(&rec, &ch, train, None).expect("dataset")
 }
 

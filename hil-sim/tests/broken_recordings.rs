@@ -32,7 +32,6 @@ const BROKEN: &[(&str, &[&str])] = &[
     ("length_mismatch.mat", &["variable `torque` has 40 samples but `t` has 50"]),
     ("nan.mat", &["variable `torque`, sample 17", "NaN"]),
     ("time_not_increasing.mat", &["sample 31: time", "does not increase"]),
-    ("char_variable.mat", &["variable `notes` is a char array"]),
     ("garbage.bin", &["binary data"]),
 ];
 
@@ -72,4 +71,19 @@ fn good_mat_files_replay_like_csv() {
         assert_eq!(v["samples"], 50);
         assert_eq!(v["warnings"], serde_json::json!([]));
     }
+}
+
+/// A variable no command uses is skipped, however unreadable as a channel: the file replays,
+/// and `--verbose` says what was skipped and why.
+#[test]
+fn unused_variables_are_skipped_and_listed() {
+    let p = params();
+    let file = corpus("char_variable.mat");
+    let out = Command::new(env!("CARGO_BIN_EXE_hil-sim"))
+        .args(["replay", file.to_str().unwrap(), "--params", p.to_str().unwrap(), "--json", "--verbose"])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("skipped variable `notes` is a char array"), "{stderr}");
 }

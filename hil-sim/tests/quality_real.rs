@@ -12,7 +12,7 @@ fn dyke(name: &str) -> PathBuf {
 }
 
 fn damper() -> Channels {
-    Channels { time: "t".into(), input: "D".into(), output: "F".into(), command: Some("Y".into()) }
+    Channels { time: "t".into(), input: "D".into(), output: "F".into(), command: Some("Y".into()), set: Vec::new() }
 }
 
 fn found(name: &str) -> Vec<(WarningKind, String, f64, f64)> {

@@ -5,6 +5,9 @@ use clap::Args;
 use hil_sim::ident::compare::{compare, Named};
 use hil_sim::ident::dataset::prepare;
 use hil_sim::ident::fit::FitOptions;
+use hil_sim::ident::runs::{from_manifest, RunSpec};
+use hil_sim::io::manifest::Role;
+use hil_sim::io::recording::Channels;
 use serde_json::json;
 
 use super::ChannelArgs;
@@ -12,8 +15,12 @@ use super::ChannelArgs;
 #[derive(Args, Debug)]
 pub struct CompareArgs {
     /// Identification recordings (one per excitation frequency in seed 000's protocol).
-    #[arg(long = "fit", required = true, num_args = 1..)]
+    #[arg(long = "fit", required_unless_present = "dataset", num_args = 1..)]
     pub fit: Vec<PathBuf>,
+    /// A dataset manifest instead: its `train` runs are the identification recordings, its
+    /// `validate` runs the validation ones (each with its own channels and constants).
+    #[arg(long, value_name = "TOML", conflicts_with_all = ["fit", "validate"])]
+    pub dataset: Option<PathBuf>,
     /// Validation recordings (seed 000: multi-sine and swept sine), replayed whole with the
     /// averaged parameters.
     #[arg(long = "validate", num_args = 1..)]
@@ -30,9 +37,9 @@ pub struct CompareArgs {
     pub json: bool,
 }
 
-fn load(path: &std::path::Path, a: &CompareArgs, train: f64) -> anyhow::Result<Named> {
+fn load(path: &std::path::Path, ch: &Channels, a: &CompareArgs, train: f64) -> anyhow::Result<Named> {
     let p = super::file_arg(path)?;
-    let prepared = prepare(&p, &a.ch.channels(), train, a.ch.keep_flagged)?;
+    let prepared = prepare(&p, ch, train, a.ch.keep_flagged)?;
     for w in &prepared.quality.warnings {
         eprintln!("warning: {}", w.message);
     }
@@ -42,12 +49,23 @@ fn load(path: &std::path::Path, a: &CompareArgs, train: f64) -> anyhow::Result<N
 
 pub fn run(a: CompareArgs) -> anyhow::Result<()> {
     let models = super::fit::model_list(&a.model)?;
-    if a.fit.is_empty() {
+    let ch = a.ch.channels();
+    let runs: Vec<RunSpec> = match &a.dataset {
+        Some(m) => from_manifest(&super::file_arg(m)?, &ch)?,
+        None => {
+            let run = |p: &PathBuf, role| RunSpec { path: p.clone(), channels: ch.clone(), role };
+            a.fit.iter().map(|p| run(p, Role::Train)).chain(a.validate.iter().map(|p| run(p, Role::Validate))).collect()
+        }
+    };
+    if !runs.iter().any(|r| r.role == Role::Train) {
         bail!("--fit: name at least one identification recording");
     }
-    let ident = a.fit.iter().map(|p| load(p, &a, a.train)).collect::<anyhow::Result<Vec<_>>>()?;
     // Validation recordings are replayed whole; the split is irrelevant there.
-    let val = a.validate.iter().map(|p| load(p, &a, 0.5)).collect::<anyhow::Result<Vec<_>>>()?;
+    let load_role = |role: Role, train: f64| -> anyhow::Result<Vec<Named>> {
+        runs.iter().filter(|r| r.role == role).map(|r| load(&r.path, &r.channels, &a, train)).collect()
+    };
+    let ident = load_role(Role::Train, a.train)?;
+    let val = load_role(Role::Validate, 0.5)?;
     let opts = FitOptions { rate: a.ch.rate()?, ..Default::default() };
     let bar = super::progress::Bar::new((models.len() * ident.len()) as u64, "comparing");
     let c = compare(&ident, &val, &models, &opts, &bar)?;

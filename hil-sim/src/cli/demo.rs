@@ -42,7 +42,7 @@ struct DykeFit {
 }
 
 fn dyke_channels() -> Channels {
-    Channels { time: "t".into(), input: "D".into(), output: "F".into(), command: Some("Y".into()) }
+    Channels { time: "t".into(), input: "D".into(), output: "F".into(), command: Some("Y".into()), set: Vec::new() }
 }
 
 fn fit_dyke(file: &'static str) -> anyhow::Result<DykeFit> {
@@ -195,8 +195,13 @@ fn closed_loop(rep: &mut Report, out: &Path, text: &mut String) -> anyhow::Resul
 fn diagnosis(rep: &mut Report, out: &Path, text: &mut String) -> anyhow::Result<Diagnosis> {
     eprintln!("diagnosing ranran_50.csv from bouc_wen without the command channel");
     let diag_rec = hil_sim::io::bundled::data_file("dyke/ranran_50.csv").map_err(anyhow::Error::msg)?;
-    let diag_ch =
-        hil_sim::io::recording::Channels { time: "t".into(), input: "D".into(), output: "F".into(), command: None };
+    let diag_ch = hil_sim::io::recording::Channels {
+        time: "t".into(),
+        input: "D".into(),
+        output: "F".into(),
+        command: None,
+        set: Vec::new(),
+    };
     let diag_opts = hil_sim::ident::diagnose::DiagnoseOptions {
         model: Some(<model_core::models::bouc_wen::Registered as model_core::Model>::ID.into()),
         heldout: 0.3,

@@ -2,17 +2,18 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
-use hil_sim::ident::dataset::{prepare, Dataset, Prepared};
+use hil_sim::ident::dataset::{Dataset, Prepared};
 use hil_sim::ident::diagnose::{diagnose, leak, DiagnoseError, DiagnoseOptions, Diagnosis};
+use hil_sim::ident::runs::{prepare_runs, RunSpec, RunsError};
 use hil_sim::io::recording::Channels;
 
 use super::progress::Bar;
-use super::ChannelArgs;
+use super::{ChannelArgs, RecordingArgs};
 
 #[derive(Args, Debug)]
 pub struct DiagnoseArgs {
-    /// Recording (CSV or MAT).
-    pub rec: PathBuf,
+    #[command(flatten)]
+    pub recs: RecordingArgs,
     /// Base model id, or `auto` (every seed model; the best held-out one is the base).
     #[arg(long, default_value = "auto")]
     pub model: String,
@@ -50,17 +51,33 @@ pub fn run_diagnosis(
     keep_flagged: bool,
     opts: &DiagnoseOptions,
 ) -> anyhow::Result<(Diagnosis, Dataset)> {
+    let run = RunSpec { path: super::file_arg(rec)?, channels: ch.clone(), role: hil_sim::io::manifest::Role::Train };
+    run_diagnosis_runs(&[run], keep_flagged, opts)
+}
+
+/// [`run_diagnosis`] of a dataset: the runs joined with their boundaries kept
+/// ([`Dataset::run_starts`]), the auxiliary channels every run has joined the same way.
+pub fn run_diagnosis_runs(
+    runs: &[RunSpec],
+    keep_flagged: bool,
+    opts: &DiagnoseOptions,
+) -> anyhow::Result<(Diagnosis, Dataset)> {
     opts.check().map_err(flagged)?;
-    let path = super::file_arg(rec)?;
-    let Prepared { recording: rec, quality: q, data } = prepare(&path, ch, 1.0 - opts.heldout, keep_flagged)?;
+    let Some(first) = runs.first() else { anyhow::bail!("no recording given") };
+    let (path, ch) = (&first.path, &first.channels);
+    let prepared = prepare_runs(runs, 1.0 - opts.heldout, keep_flagged).map_err(|e| match e {
+        RunsError::Dataset(d) => anyhow::Error::from(d),
+        e => e.into(),
+    })?;
+    let Prepared { quality: q, data, .. } = prepared.joined;
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
     }
     for n in &q.notes {
         eprintln!("warning: {n}");
     }
-    let output = rec.channel(&ch.output)?;
-    let (aux, dropped) = leak::screen(rec.auxiliary_channels(ch), output, ch.command.as_deref());
+    let aux = joined_auxiliary(&prepared.runs, runs);
+    let (aux, dropped) = leak::screen(aux, &data.output, ch.command.as_deref());
     for d in &dropped {
         eprintln!("warning: {}: channel `{}` is not used by the diagnosis: {}", path.display(), d.name, d.reason);
     }
@@ -69,6 +86,23 @@ pub fn run_diagnosis(
     bar.finish();
     let d = d.map_err(flagged).with_context(|| format!("diagnosing {}", path.display()))?;
     Ok((d, data))
+}
+
+/// The auxiliary channels of every run, joined end to end (a channel some run lacks is left out).
+fn joined_auxiliary(prepared: &[Prepared], runs: &[RunSpec]) -> Vec<(String, Vec<f64>)> {
+    let per_run: Vec<Vec<(String, Vec<f64>)>> =
+        prepared.iter().zip(runs).map(|(p, r)| p.recording.auxiliary_channels(&r.channels)).collect();
+    let Some(first) = per_run.first() else { return Vec::new() };
+    first
+        .iter()
+        .filter_map(|(name, _)| {
+            let mut v = Vec::new();
+            for run in &per_run {
+                v.extend_from_slice(&run.iter().find(|(n, _)| n == name)?.1);
+            }
+            Some((name.clone(), v))
+        })
+        .collect()
 }
 
 pub fn run(a: DiagnoseArgs) -> anyhow::Result<()> {
@@ -87,10 +121,15 @@ pub fn run(a: DiagnoseArgs) -> anyhow::Result<()> {
         }
     }
     let opts = DiagnoseOptions { rate: a.ch.rate()?, ..opts };
-    let (d, _) = run_diagnosis(&a.rec, &a.ch.channels(), a.ch.keep_flagged, &opts)?;
+    let runs = a.recs.runs(&a.ch.channels())?;
+    let (d, _) = run_diagnosis_runs(&runs, a.ch.keep_flagged, &opts)?;
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-        let mut rep = hil_sim::report::Report::new(format!("Diagnosis of {}", hil_sim::report::file_label(&a.rec)));
+        let label = match a.recs.recs.as_slice() {
+            [one] if a.recs.dataset.is_none() => hil_sim::report::file_label(one),
+            _ => a.recs.label(),
+        };
+        let mut rep = hil_sim::report::Report::new(format!("Diagnosis of {label}"));
         hil_sim::report::diagnose::section(&mut rep, dir, "diagnose", &d, (&a.ch.input, &a.ch.output))?;
         let index = rep.write(dir)?;
         eprintln!("report written to {}", index.display());

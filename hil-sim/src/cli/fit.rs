@@ -8,12 +8,12 @@ use hil_sim::report::fit::Labels;
 use hil_sim::report::fit_page;
 use serde_json::json;
 
-use super::ChannelArgs;
+use super::{ChannelArgs, RecordingArgs};
 
 #[derive(Args, Debug)]
 pub struct FitArgs {
-    /// Recording (CSV).
-    pub rec: PathBuf,
+    #[command(flatten)]
+    pub recs: RecordingArgs,
     /// Model id (see `hil-sim models`), a comma-separated list, or `all`.
     #[arg(long, default_value = "all")]
     pub model: String,
@@ -87,8 +87,7 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
     let mut options = FitOptions { rate: a.ch.rate()?, delay: a.delay, ..Default::default() };
     options.swarm.seed = a.seed;
     let fit_job = FitJob {
-        recording: super::file_arg(&a.rec)?,
-        channels: a.ch.channels(),
+        runs: a.recs.runs(&a.ch.channels())?,
         train: a.train,
         keep_flagged: a.ch.keep_flagged,
         models: model_list(&a.model)?,
@@ -103,7 +102,10 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
         _ => e.into(),
     })?;
     bar.finish();
-    let (path, data, q) = (&fit_job.recording, &run.prepared.data, &run.prepared.quality);
+    let (label, data, q) = (a.recs.label(), &run.prepared.data, &run.prepared.quality);
+    for r in &run.runs {
+        super::list_skipped(a.ch.verbose, &r.recording);
+    }
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
     }
@@ -119,27 +121,34 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
         }
     }
     if let Some(dir) = &a.out {
-        let title = format!("Fit of {}", hil_sim::report::file_label(path));
+        let title = match a.recs.recs.as_slice() {
+            [one] if a.recs.dataset.is_none() => format!("Fit of {}", hil_sim::report::file_label(one)),
+            _ => format!("Fit of {label}"),
+        };
         let labels = Labels::for_channels(&a.ch.input, &a.ch.output);
+        // Messages name files without the user's folders.
+        let paths: Vec<&std::path::Path> = run.runs.iter().map(|r| r.recording.path.as_path()).collect();
         let warnings: Vec<String> = q
             .warnings
             .iter()
             .map(|w| w.message.clone())
             .chain(q.notes.iter().cloned())
-            .map(|m| hil_sim::report::relabel(&m, path))
+            .map(|m| paths.iter().fold(m, |m, p| hil_sim::report::relabel(&m, p)))
             .collect();
         let index = fit_page::write(dir, &title, data, &run.results, &labels, &warnings)?;
         eprintln!("report written to {}", index.display());
     }
     let best = run.best().map(|r| r.model.clone());
+    // Samples in training parts (all of a dataset's runs; `train_end` for one recording).
+    let train_samples: usize = data.spans().iter().map(|r| r.train_end - r.start).sum();
     if a.json {
         return super::print_json(&json!({
-            "recording": path.display().to_string(),
+            "recording": label,
             "samples": data.len(),
             "dt_s": data.dt,
             "train_fraction": a.train,
-            "train_samples": data.train_end,
-            "heldout_samples": data.len() - data.train_end,
+            "train_samples": train_samples,
+            "heldout_samples": data.len() - train_samples,
             "warnings": q.warnings,
             "notes": q.notes,
             "excluded_samples": if a.ch.keep_flagged { 0 } else { q.excluded_samples },
@@ -148,20 +157,64 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
             "total_seconds": run.total_seconds,
         }));
     }
-    super::emit(&format!(
-        "{}: {} samples at {:.1} Hz; fit on the first {:.0} % ({} samples), scored on the last {} samples\n\n",
-        path.display(),
-        data.len(),
-        1.0 / data.dt,
-        100.0 * a.train,
-        data.train_end,
-        data.len() - data.train_end
-    ));
+    if data.runs.is_empty() {
+        super::emit(&format!(
+            "{}: {} samples at {:.1} Hz; fit on the first {:.0} % ({} samples), scored on the last {} samples\n\n",
+            label,
+            data.len(),
+            1.0 / data.dt,
+            100.0 * a.train,
+            data.train_end,
+            data.len() - data.train_end
+        ));
+    } else {
+        let validate = data.runs.iter().any(|r| r.role == hil_sim::io::manifest::Role::Validate);
+        super::emit(&format!(
+            "{}: {} runs, {} samples at {:.1} Hz; the model restarts at each run; {}\n\n",
+            label,
+            data.runs.len(),
+            data.len(),
+            1.0 / data.dt,
+            if validate {
+                "fit on the train runs, scored on the validate runs".to_owned()
+            } else {
+                format!("fit on the first {:.0} % of each run, scored on the rest", 100.0 * a.train)
+            }
+        ));
+    }
     super::emit(&table(&run.results));
+    if !data.runs.is_empty() {
+        super::emit(&run_table(&run.results));
+    }
     if let Some(b) = best {
         super::emit(&format!("\nbest held-out: {b}; total {:.2} s\n", run.total_seconds));
     }
     Ok(())
+}
+
+/// Each run's metrics, one row per model and run (pooled figures are in [`table`]).
+pub fn run_table(results: &[FitResult]) -> String {
+    let mut s = format!(
+        "\nper run:\n{:<16} {:<32} {:<9} {:<8} {:>10} {:>9} {:>8}\n",
+        "model", "run", "role", "scored", "RMSE", "R²", "R-RMSE"
+    );
+    for r in results {
+        for run in &r.runs {
+            let file =
+                std::path::Path::new(&run.file).file_name().map_or(run.file.clone(), |f| f.to_string_lossy().into());
+            s += &format!(
+                "{:<16} {:<32} {:<9} {:<8} {:>10.4} {:>9} {:>7.2}%\n",
+                r.model,
+                file,
+                run.role.label(),
+                run.part,
+                run.metrics.rmse,
+                super::fixed(run.metrics.r2, 4),
+                100.0 * run.metrics.r_rmse
+            );
+        }
+    }
+    s
 }
 
 /// The comparison table, one row per model.

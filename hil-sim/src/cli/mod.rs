@@ -93,6 +93,72 @@ pub struct ChannelArgs {
     /// spike, non-uniform sampling) in the fit; by default they are excluded.
     #[arg(long)]
     pub keep_flagged: bool,
+    /// A constant channel for a recording that lacks it, `NAME=VALUE` (e.g. `--set V=2.178`
+    /// with `--command V`); repeatable.
+    #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_set)]
+    pub set: Vec<(String, f64)>,
+    /// List the variables of the file that are not channels (and why) on stderr.
+    #[arg(long)]
+    pub verbose: bool,
+}
+
+/// The recordings of a subcommand: one or several files, or a dataset manifest.
+#[derive(Args, Debug, Clone)]
+pub struct RecordingArgs {
+    /// Recording(s): CSV/text or level-5 MAT-files; several are identified as one dataset
+    /// (the model restarts at each, parameters are shared).
+    #[arg(required_unless_present = "dataset")]
+    pub recs: Vec<PathBuf>,
+    /// A dataset manifest (TOML: `[channels]` defaults and one `[[run]]` per recording with
+    /// its `file`, `set` and `role` = train|validate; see README).
+    #[arg(long, value_name = "TOML", conflicts_with = "recs")]
+    pub dataset: Option<PathBuf>,
+}
+
+impl RecordingArgs {
+    /// The runs named, each with its channels (the manifest's over `ch`'s).
+    pub fn runs(&self, ch: &Channels) -> anyhow::Result<Vec<hil_sim::ident::runs::RunSpec>> {
+        use hil_sim::ident::runs::{from_manifest, RunSpec};
+        if let Some(m) = &self.dataset {
+            let runs = from_manifest(&file_arg(m)?, ch)?;
+            for r in &runs {
+                file_arg(&r.path).map_err(|e| anyhow::anyhow!("{}: run {e}", m.display()))?;
+            }
+            return Ok(runs);
+        }
+        self.recs
+            .iter()
+            .map(|p| Ok(RunSpec { path: file_arg(p)?, channels: ch.clone(), role: hil_sim::io::manifest::Role::Train }))
+            .collect()
+    }
+
+    /// How the recordings are named in messages: the file, or the manifest.
+    pub fn label(&self) -> String {
+        match (&self.dataset, self.recs.as_slice()) {
+            (Some(m), _) => m.display().to_string(),
+            (None, [one]) => one.display().to_string(),
+            (None, many) => format!("{} recordings", many.len()),
+        }
+    }
+}
+
+/// `NAME=VALUE`, the syntax of `--set`.
+pub fn parse_set(s: &str) -> Result<(String, f64), String> {
+    let (name, value) = s.split_once('=').ok_or_else(|| format!("`{s}`: expected NAME=VALUE (e.g. V=2.178)"))?;
+    let v: f64 = value.trim().parse().map_err(|_| format!("`{s}`: `{value}` is not a number"))?;
+    if name.trim().is_empty() || !v.is_finite() {
+        return Err(format!("`{s}`: expected NAME=VALUE with a finite value"));
+    }
+    Ok((name.trim().to_owned(), v))
+}
+
+/// With `--verbose`, the variables of `rec` that are not channels, one line each on stderr.
+pub fn list_skipped(verbose: bool, rec: &hil_sim::io::recording::Recording) {
+    if verbose {
+        for s in &rec.skipped {
+            eprintln!("note: {}: skipped {}", rec.path.display(), s.reason);
+        }
+    }
 }
 
 impl ChannelArgs {
@@ -102,6 +168,7 @@ impl ChannelArgs {
             input: self.input.clone(),
             output: self.output.clone(),
             command: self.command.clone(),
+            set: self.set.clone(),
         }
     }
     /// The rate estimator named by `--rate`; `None` for `auto`.

@@ -10,6 +10,7 @@
 use serde::Serialize;
 
 use crate::ident::fit::{fit, Dataset, DelayChoice, FitError, FitOptions, FitResult};
+use crate::ident::own_runs::{self, OwnRunsCheck};
 use crate::io::params_file::{ParamsFile, Values};
 use crate::models::replay;
 use crate::numerics::metrics::{metrics, Metrics};
@@ -42,9 +43,16 @@ pub struct Averaged {
     pub fit_seconds: f64,
     /// Mean f32 replay time per sample, nanoseconds.
     pub replay_ns_per_sample: f64,
-    /// Whether the averaged set is a valid parameter set of the model (averaging can leave
-    /// the admissible region; then the model is not validated).
+    /// Whether the averaged set is valid: a parameter set of the model (averaging can leave
+    /// the admissible region; then the model is not validated) that is not worse than the
+    /// recordings' own fits by more than chance on the recordings it came from.
     pub valid: bool,
+    /// The averaged set on its own recordings ([`crate::ident::own_runs`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub own_runs: Option<OwnRunsCheck>,
+    /// Why the set is not valid, in words (`None` when it is).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub not_valid: Option<String>,
     #[serde(skip)]
     pub flat: Vec<f64>,
     #[serde(skip)]
@@ -104,8 +112,23 @@ pub fn compare(
             }
         }
         let flat32: Vec<f32> = flat.iter().map(|v| *v as f32).collect();
-        let valid = crate::ident::fit::simulate::simulator(id, identify.first().map_or(1e-3, |r| r.data.dt) as f32)
-            .is_some_and(|s| s.valid(&flat));
+        let admissible =
+            crate::ident::fit::simulate::simulator(id, identify.first().map_or(1e-3, |r| r.data.dt) as f32)
+                .is_some_and(|s| s.valid(&flat));
+        let own = if admissible { on_own_runs(id, &flat32, first.rate_choice, identify, &results)? } else { None };
+        let not_valid = if !admissible {
+            Some("the averaged set is not a valid parameter set of the model".to_owned())
+        } else {
+            own.as_ref().filter(|c| c.worse).map(|c| {
+                format!(
+                    "on the held-out parts of its own recordings the averaged set scores RMSE {:.4} against {:.4} \
+                     for their own fits ({:.1} standard errors, more than chance): the per-recording fits \
+                     compensate each other and their average is not a model of the device",
+                    c.averaged_rmse, c.own_rmse, c.z
+                )
+            })
+        };
+        let valid = not_valid.is_none();
         averaged.push(Averaged {
             model: id.clone(),
             params: ParamsFile::from_flat(id, None, &flat32).map_or(Values::Flat(flat.clone()), |f| f.params),
@@ -114,12 +137,15 @@ pub fn compare(
             fit_seconds: results.iter().map(|r| r.fit_seconds).sum::<f64>() / n,
             replay_ns_per_sample: results.iter().map(|r| r.replay_ns_per_sample).sum::<f64>() / n,
             valid,
+            own_runs: own,
+            not_valid,
             flat,
             rate: first.rate_choice,
         });
     }
     let mut validation = Vec::new();
-    for a in averaged.iter().filter(|a| a.valid) {
+    // An inadmissible set cannot run; a set worse on its own runs is still scored (and marked).
+    for a in averaged.iter().filter(|a| a.valid || a.own_runs.is_some()) {
         for rec in validate {
             let d = &rec.data;
             let p32: Vec<f32> = a.flat.iter().map(|v| *v as f32).collect();
@@ -134,6 +160,30 @@ pub fn compare(
         }
     }
     Ok(Comparison { fits, averaged, validation })
+}
+
+/// The averaged set `p` replayed on the identification recordings, against their own fits.
+fn on_own_runs(
+    id: &str,
+    p: &[f32],
+    rate: crate::models::RateSpec,
+    identify: &[Named],
+    fits: &[FitResult],
+) -> Result<Option<OwnRunsCheck>, FitError> {
+    let mut avg = Vec::with_capacity(identify.len());
+    for rec in identify {
+        let d = &rec.data;
+        let rep = crate::models::replay::replay_runs(id, p, d.dt as f32, rate, &d.samples(), &d.run_starts())
+            .map_err(|e| FitError::Replay { model: id.to_owned(), reason: e.to_string() })?;
+        avg.push(rep.y.iter().map(|v| f64::from(*v)).collect::<Vec<f64>>());
+    }
+    let parts: Vec<own_runs::Part<'_>> = identify
+        .iter()
+        .zip(fits)
+        .zip(&avg)
+        .map(|((rec, f), a)| (rec.data.output.as_slice(), f.output.as_slice(), a.as_slice(), rec.data.heldout_rows()))
+        .collect();
+    Ok(own_runs::check(&parts))
 }
 
 impl Comparison {
@@ -178,6 +228,11 @@ impl Comparison {
                 a.state_bytes,
                 if a.valid { "yes" } else { "no" }
             );
+        }
+        for a in self.averaged.iter() {
+            if let Some(why) = &a.not_valid {
+                s += &format!("{}: not valid: {why}\n", a.model);
+            }
         }
         s
     }

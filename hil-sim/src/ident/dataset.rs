@@ -52,6 +52,19 @@ pub struct Dataset {
     /// Given rate and acceleration of the input (e.g. [`crate::numerics::derivative::rates`]): fed to
     /// the models instead of the rate estimator's when present.
     pub rates: Option<(Vec<f64>, Vec<f64>)>,
+    /// The runs of a dataset joined end to end ([`crate::ident::runs`]): the model restarts at
+    /// each run's start and each has its own split. Empty: one run, split at `train_end`.
+    pub runs: Vec<RunSpan>,
+}
+
+/// One run of a dataset: samples `start..end` of the joined data, `start..train_end` fitted.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunSpan {
+    pub file: PathBuf,
+    pub role: crate::io::manifest::Role,
+    pub start: usize,
+    pub train_end: usize,
+    pub end: usize,
 }
 
 impl Dataset {
@@ -77,7 +90,18 @@ impl Dataset {
             return Err(DatasetError::NoHeldOut);
         }
         let excluded = excluded.filter(|e| e.len() == n).unwrap_or_else(|| vec![false; n]);
-        let d = Self { dt, time, input, output, command, train_end, excluded, unusable: Vec::new(), rates: None };
+        let d = Self {
+            dt,
+            time,
+            input,
+            output,
+            command,
+            train_end,
+            excluded,
+            unusable: Vec::new(),
+            rates: None,
+            runs: Vec::new(),
+        };
         let usable = d.train_rows().len();
         if usable < 20 {
             return Err(DatasetError::TooFewSamples(usable));
@@ -98,9 +122,48 @@ impl Dataset {
         crate::models::replay::samples_with_rates(&self.input, self.command.as_deref(), self.rates.as_ref())
     }
 
+    /// The runs (one spanning everything, split at `train_end`, for a single recording).
+    pub fn spans(&self) -> Vec<RunSpan> {
+        if self.runs.is_empty() {
+            vec![RunSpan {
+                file: PathBuf::new(),
+                role: crate::io::manifest::Role::Train,
+                start: 0,
+                train_end: self.train_end,
+                end: self.len(),
+            }]
+        } else {
+            self.runs.clone()
+        }
+    }
+
+    /// Where each run starts (sample indices; `[0]` for a single recording): the model's state,
+    /// rates and delays restart there.
+    pub fn run_starts(&self) -> Vec<usize> {
+        self.spans().iter().map(|r| r.start).collect()
+    }
+
+    /// Whether sample `i` is in a training part.
+    pub fn is_train(&self, i: usize) -> bool {
+        if self.runs.is_empty() {
+            return i < self.train_end;
+        }
+        self.runs.iter().any(|r| (r.start..r.train_end).contains(&i))
+    }
+
     /// Training samples that enter the fit.
     pub fn train_rows(&self) -> Vec<usize> {
-        (0..self.train_end).filter(|&i| !self.excluded.get(i).copied().unwrap_or(false) && self.usable(i)).collect()
+        self.spans()
+            .iter()
+            .flat_map(|r| r.start..r.train_end)
+            .filter(|&i| !self.excluded.get(i).copied().unwrap_or(false) && self.usable(i))
+            .collect()
+    }
+
+    /// Every held-out sample that may be scored (the `validate` runs of a dataset, or the
+    /// end of each run).
+    pub fn heldout_rows(&self) -> Vec<usize> {
+        self.spans().iter().flat_map(|r| r.train_end..r.end).filter(|&i| self.usable(i)).collect()
     }
 
     /// Whether sample `i` may be scored at all (not a gross outlier).
@@ -110,7 +173,31 @@ impl Dataset {
 
     /// Held-out samples the quality checks did not flag.
     pub fn heldout_unflagged(&self) -> Vec<usize> {
-        (self.train_end..self.len()).filter(|&i| !self.excluded.get(i).copied().unwrap_or(false)).collect()
+        self.spans()
+            .iter()
+            .flat_map(|r| r.train_end..r.end)
+            .filter(|&i| !self.excluded.get(i).copied().unwrap_or(false))
+            .collect()
+    }
+
+    /// `rows` without the samples a delay of `ds` samples leaves uncovered at either end of
+    /// their run ([`crate::models::alignment::covered`], per run).
+    pub fn covered(&self, rows: &[usize], ds: &[f64]) -> Vec<usize> {
+        let spans = self.spans();
+        rows.iter()
+            .copied()
+            .filter(|&i| {
+                spans.iter().find(|r| (r.start..r.end).contains(&i)).is_some_and(|r| {
+                    let (lo, hi) = crate::models::alignment::covered(r.end - r.start, ds);
+                    (r.start + lo..r.start + hi).contains(&i)
+                })
+            })
+            .collect()
+    }
+
+    /// `f` applied to each run's part of `v`, joined: a computation that must not cross a join.
+    pub fn per_run(&self, v: &[f64], f: impl Fn(&[f64]) -> Vec<f64>) -> Vec<f64> {
+        self.spans().iter().flat_map(|r| f(v.get(r.start..r.end).unwrap_or(&[]))).collect()
     }
 
     /// Spreads of the training part (see [`Scales`]).
@@ -118,8 +205,8 @@ impl Dataset {
         let rows = self.train_rows();
         let pick = |v: &[f64]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
         let x = pick(&self.input);
-        let dx = gradient(&self.input, self.dt);
-        let ddx = gradient(&dx, self.dt);
+        let dx = self.per_run(&self.input, |v| gradient(v, self.dt));
+        let ddx = self.per_run(&dx, |v| gradient(v, self.dt));
         let (x_mean, xs) = mean_std(&x);
         let (y_mean, ys) = mean_std(&pick(&self.output));
         let u = self.command.as_ref().map(|u| pick(u).iter().fold(0.0f64, |a, b| a.max(b.abs())));
@@ -164,11 +251,12 @@ pub fn prepare(path: &Path, ch: &Channels, train: f64, keep_flagged: bool) -> Re
 
 /// [`prepare`] for a recording already in memory (a generated one, or a file read before).
 pub fn prepare_recording(
-    recording: Recording,
+    mut recording: Recording,
     ch: &Channels,
     train: f64,
     keep_flagged: bool,
 ) -> Result<Prepared, DatasetError> {
+    recording.apply_constants(ch)?;
     let quality = quality::check(&recording, ch)?;
     let excluded = (!keep_flagged).then(|| quality.excluded());
     let mut data = Dataset::new(&recording, ch, train, excluded)

@@ -5,3 +5,5 @@ pub mod compare;
 pub mod dataset;
 pub mod diagnose;
 pub mod fit;
+pub mod own_runs;
+pub mod runs;

@@ -3,6 +3,7 @@
 
 pub mod bundled;
 pub mod config_page;
+pub mod manifest;
 pub mod output;
 pub mod params_file;
 pub mod rate;

@@ -59,7 +59,38 @@ pub struct ParamsFile {
     /// Command delay, seconds: replay feeds the model `u(t + command_delay_s)`. Absent means 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub command_delay_s: Option<f64>,
+    /// The channels the set was fitted on (`fit --save`): replay reads them by default, and a
+    /// set fitted with a command channel is not replayed without one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub channels: Option<FittedChannels>,
     pub params: Values,
+}
+
+/// The channels a set was fitted on, as the flags name them.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+pub struct FittedChannels {
+    pub time: String,
+    pub input: String,
+    pub output: String,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub command: Option<String>,
+    /// Constants given for channels the recordings lacked (`--set`), by name; a dataset's
+    /// runs may each have had their own value, so these are informative only.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub set: BTreeMap<String, f64>,
+}
+
+impl FittedChannels {
+    /// From the channels of a fit.
+    pub fn of(ch: &crate::io::recording::Channels) -> Self {
+        Self {
+            time: ch.time.clone(),
+            input: ch.input.clone(),
+            output: ch.output.clone(),
+            command: ch.command.clone(),
+            set: ch.set.iter().cloned().collect(),
+        }
+    }
 }
 
 /// Split a registry name `w[56]` into (`w`, 56); a plain name is (`name`, 1).
@@ -152,6 +183,7 @@ impl ParamsFile {
             rate: None,
             delay_s: None,
             command_delay_s: None,
+            channels: None,
             params: Values::Named(map),
         })
     }

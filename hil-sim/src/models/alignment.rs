@@ -79,6 +79,36 @@ pub fn shift_channels(x: &[f64], u: Option<&[f64]>, d: f64, d_u: f64) -> (Vec<f6
     (shift(x, d), u.map(|u| shift(u, d_u)))
 }
 
+/// [`shift_kin`] within each run of a dataset (runs start at `starts`): no run reads
+/// another's samples.
+pub fn shift_kin_runs(kin: &[Kin], d: f64, d_u: f64, starts: &[usize], out: &mut Vec<Kin>) {
+    let n = kin.len();
+    let bounds: Vec<usize> = starts.iter().copied().filter(|&s| s > 0 && s < n).collect();
+    if bounds.is_empty() {
+        return shift_kin(kin, d, d_u, out);
+    }
+    out.clear();
+    let mut seg = Vec::new();
+    let mut a = 0;
+    for b in bounds.into_iter().chain([n]) {
+        shift_kin(kin.get(a..b).unwrap_or(&[]), d, d_u, &mut seg);
+        out.append(&mut seg);
+        a = b;
+    }
+}
+
+/// `x` shifted by `d` samples within each run (runs start at `starts`).
+pub fn shift_runs(x: &[f64], d: f64, starts: &[usize]) -> Vec<f64> {
+    let n = x.len();
+    let mut out = Vec::with_capacity(n);
+    let mut a = 0;
+    for b in starts.iter().copied().filter(|&s| s > 0 && s < n).chain([n]) {
+        out.extend(shift(x.get(a..b).unwrap_or(&[]), d));
+        a = b;
+    }
+    out
+}
+
 /// The kinematics `x, ẋ, ẍ` read `d` samples later and the command `u` read `d_u` samples
 /// later. The rate estimators are linear and time-invariant, so this equals (up to the
 /// start-up transient and the interpolation) the kinematics of the shifted input; the fit

@@ -25,6 +25,26 @@ pub struct ReplayReport {
     pub measured: Vec<f64>,
     #[serde(skip)]
     pub model_output: Vec<f64>,
+    /// The input's rate and acceleration (central differences), for the metrics.
+    #[serde(skip)]
+    pub rates: (Vec<f64>, Vec<f64>),
+    /// The samples scored (`lo..hi`: a delayed channel leaves the ends unscored).
+    #[serde(skip)]
+    pub scored: (usize, usize),
+}
+
+/// The metrics of several replays (the runs of a dataset) pooled: every run's scored samples.
+pub fn pooled(reports: &[ReplayReport]) -> Result<Metrics, NoSamples> {
+    let (mut y, mut m, mut dx, mut ddx) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for r in reports {
+        let (lo, hi) = r.scored;
+        let part = |v: &[f64]| v.get(lo..hi).unwrap_or(&[]).to_vec();
+        y.extend(part(&r.measured));
+        m.extend(part(&r.model_output));
+        dx.extend(part(&r.rates.0));
+        ddx.extend(part(&r.rates.1));
+    }
+    try_metrics(&y, &m, Some((&dx, &ddx)))
 }
 
 /// Replay `rec` through `model` with flat `params`, the input and the command read
@@ -65,6 +85,8 @@ pub fn replay_recording(
         time: t.to_vec(),
         measured: y.to_vec(),
         model_output,
+        rates: (dx, ddx),
+        scored: (lo, hi),
     })
 }
 
@@ -149,6 +171,28 @@ pub fn replay(id: &str, params: &[f32], dt: f32, rate: RateSpec, samples: &[Samp
     visit(id, Run { params, dt, rate, samples })
         .ok_or_else(|| ReplayError::UnknownModel(id.to_owned()))?
         .map_err(|source| ReplayError::Params { model: id.to_owned(), source })
+}
+
+/// [`replay`] of a dataset whose runs start at `starts`: the core (state and rate
+/// estimator) restarts at every run.
+pub fn replay_runs(
+    id: &str,
+    params: &[f32],
+    dt: f32,
+    rate: RateSpec,
+    samples: &[Sample],
+    starts: &[usize],
+) -> Result<Replay, ReplayError> {
+    let n = samples.len();
+    let mut out = Replay { y: Vec::with_capacity(n), held: 0 };
+    let mut a = 0;
+    for b in starts.iter().copied().filter(|&s| s > 0 && s < n).chain([n]) {
+        let r = replay(id, params, dt, rate, samples.get(a..b).unwrap_or(&[]))?;
+        out.y.extend(r.y);
+        out.held += r.held;
+        a = b;
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -21,6 +21,9 @@ pub struct QualityConfig {
     /// for at least this long (s) and at least `standstill_half_periods` T½.
     pub standstill_min_s: f64,
     pub standstill_half_periods: f64,
+    /// An input clipping or hold episode through which the output stays within this fraction
+    /// of its span is the device at rest (a standstill), not a sensor fault.
+    pub standstill_output_band: f64,
     /// Held value: at least this many bit-identical samples, and at least 3× the longest
     /// run the channel's own repeat rate makes likely by chance.
     pub hold_samples: usize,
@@ -48,6 +51,7 @@ impl Default for QualityConfig {
             standstill_band: 0.01,
             standstill_min_s: 0.5,
             standstill_half_periods: 4.0,
+            standstill_output_band: 0.05,
             hold_samples: 10,
             spike_ratio: 20.0,
             spike_span: 0.02,

@@ -127,6 +127,7 @@ pub fn check_with(rec: &Recording, ch: &Channels, cfg: &QualityConfig) -> Result
         found.extend(major);
         found.extend(minor);
     }
+    standstill::reclassify(&ctx, &ch.input, x, y, &mut found, cfg);
     found.sort_by(|a, b| a.start_s.total_cmp(&b.start_s).then_with(|| a.channel.cmp(&b.channel)));
     unusable.sort_unstable();
     unusable.dedup();

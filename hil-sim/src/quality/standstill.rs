@@ -70,3 +70,57 @@ fn still(t: &[f64], v: &[f64], band: f64, min_s: f64) -> Vec<bool> {
     }
     mask
 }
+
+/// The input at rest, wherever it is (at the start, between tests, at the end), is a
+/// standstill — not a clipped minimum or a dropout. An input clipping or hold episode is one
+/// when the output stays quiet through it (within `standstill_output_band` of its span: a real
+/// dropout or a clipped sensor leaves the device, and so the output, moving; an end stop
+/// pushes back). Such warnings become standstill warnings, and a hold
+/// or a flat extreme of another channel inside an input standstill is dropped.
+pub(super) fn reclassify(ctx: &Ctx, input: &str, x: &[f64], y: &[f64], found: &mut Vec<Warning>, cfg: &QualityConfig) {
+    let n = x.len();
+    let (ylo, yhi) = min_max(y);
+    let y_span = yhi - ylo;
+    let (xlo, xhi) = min_max(x);
+    let x_span = (xhi - xlo).max(f64::MIN_POSITIVE);
+    let quiet = |a: usize, b: usize| {
+        let (lo, hi) = min_max(y.get(a..=b).unwrap_or(&[]));
+        y_span <= 0.0 || hi - lo <= cfg.standstill_output_band * y_span
+    };
+    let mut rest: Vec<Warning> = Vec::new();
+    found.retain(|w| {
+        let candidate = w.channel == input && matches!(w.kind, WarningKind::Clipped | WarningKind::Dropout);
+        let (a, b) = (w.first_index, w.last_index.min(n.saturating_sub(1)));
+        if !candidate || !quiet(a, b) {
+            return true;
+        }
+        let (lo, hi) = min_max(x.get(a..=b).unwrap_or(&[]));
+        let place = match (a == 0, b + 1 >= n) {
+            (true, _) => "before the test starts",
+            (_, true) => "after the test ends",
+            _ => "between tests",
+        };
+        let what = format!(
+            "{input} at rest {} ({place}, a standstill): it stays within {} to {}{} ({:.1} % of its span)",
+            ctx.when(a, b),
+            level(lo),
+            level(hi),
+            unit_suffix(input),
+            100.0 * (hi - lo) / x_span
+        );
+        rest.push(ctx.warning(WarningKind::Standstill, input, a, b, what));
+        false
+    });
+    // Holds and flat extremes of the other channels inside a standstill are the rest too.
+    let stills: Vec<(usize, usize)> = found
+        .iter()
+        .chain(&rest)
+        .filter(|w| w.channel == input && w.kind == WarningKind::Standstill)
+        .map(|w| (w.first_index, w.last_index))
+        .collect();
+    found.retain(|w| {
+        let at_rest = matches!(w.kind, WarningKind::Dropout | WarningKind::Clipped) && w.channel != input;
+        !at_rest || !stills.iter().any(|&(a, b)| a <= w.first_index && w.last_index <= b)
+    });
+    found.extend(rest);
+}

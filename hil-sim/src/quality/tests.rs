@@ -188,3 +188,25 @@ fn excluded_marks_the_warned_samples_and_messages_name_places() {
     let json = serde_json::to_value(&q).unwrap();
     assert_eq!(json["warnings"][0]["kind"], "spike");
 }
+
+#[test]
+fn rest_at_start_between_tests_and_end_is_a_standstill() {
+    let (t, mut b, mut y) = signals();
+    let e = noise(b.len(), 5);
+    let lowest = b.iter().copied().fold(f64::INFINITY, f64::min);
+    // At rest at the input's minimum before the test (0–0.3 s), held bit for bit between two
+    // tests (5.0–5.2 s) and after the end (9.8–10 s); the output stays quiet with it.
+    let n = b.len();
+    for (range, at) in [(0..300, lowest), (5000..5200, b[5000]), (9800..n, b[9800])] {
+        for i in range {
+            b[i] = at;
+            y[i] = 2.0 * at + 2e-3 * e[i];
+        }
+    }
+    let w = warnings(&rec(t, b, y));
+    assert!(!w.is_empty(), "nothing found");
+    assert!(w.iter().all(|w| w.0 == WarningKind::Standstill && w.1 == "b"), "{w:?}");
+    for (a, z) in [(0.0, 0.299), (5.0, 5.199), (9.8, 9.999)] {
+        assert!(w.iter().any(|w| near(w.2, a) && near(w.3, z)), "no standstill at {a}–{z} s: {w:?}");
+    }
+}

@@ -35,15 +35,24 @@ pub fn write(
     for w in warnings {
         rep.paragraph(&format!("**Quality warning:** {w}"));
     }
+    let fitted = (0..data.len()).filter(|&i| data.is_train(i)).count();
+    let split = if data.runs.len() > 1 {
+        format!(
+            "{} runs, each model's state restarting at each; fitted on {fitted} samples, scored on the other {}",
+            data.runs.len(),
+            data.len() - fitted
+        )
+    } else {
+        format!("fitted on the first {fitted} samples, scored on the last {}", data.len() - fitted)
+    };
     rep.paragraph(&format!(
-        "{} samples at {:.1} Hz; fitted on the first {} samples, scored on the last {}. Metrics are from the \
-         f32 replay through model-core (the firmware's code), one step per sample.",
+        "{} samples at {:.1} Hz; {split}. Metrics are from the f32 replay through model-core (the firmware's \
+         code), one step per sample.",
         data.len(),
         1.0 / data.dt,
-        data.train_end,
-        data.len() - data.train_end
     ));
     results_table(&mut rep, results, labels);
+    super::runs::section(&mut rep, data, results);
     let stem = |m: &str| format!("fit_{m}");
     error_bars(&mut rep, dir, "fit", results)?;
     if let Some(best) = results.iter().min_by(|x, y| x.heldout.rmse.total_cmp(&y.heldout.rmse)) {

@@ -18,6 +18,7 @@ pub mod fit;
 pub mod fit_page;
 pub mod number;
 pub mod plot;
+pub mod runs;
 pub mod scores;
 
 use std::fmt::Write as _;

@@ -14,7 +14,7 @@ const STILL_FRACTION: f64 = 0.02;
 /// The held-out scores of `r` with the sentences that explain them: `unit` is the output's
 /// unit (`"N"`), `output` its name (`"F"`).
 pub fn heldout_note(data: &Dataset, r: &FitResult, output: &str, unit: &str) -> String {
-    let held = data.len().saturating_sub(data.train_end);
+    let held = data.heldout_rows().len();
     let mut s = format!(
         "Held-out over all {held} samples: RMSE {}, R² {:.4}, R-RMSE {:.2} %.",
         with_unit(r.heldout.rmse, 4, unit),
@@ -22,7 +22,7 @@ pub fn heldout_note(data: &Dataset, r: &FitResult, output: &str, unit: &str) -> 
         100.0 * r.heldout.r_rmse
     );
     if let Some(u) = &r.heldout_unflagged {
-        let flagged = data.excluded.get(data.train_end..).map_or(0, |e| e.iter().filter(|x| **x).count());
+        let flagged = held.saturating_sub(data.heldout_unflagged().len());
         let why = if u.rmse < r.heldout.rmse {
             "the flagged samples carry most of the error: the model was fitted without them and cannot follow \
              what the sensor did there (see the quality warnings: e.g. a clipped end stop, a dropout), so the \
@@ -35,7 +35,7 @@ pub fn heldout_note(data: &Dataset, r: &FitResult, output: &str, unit: &str) -> 
         s += &format!(
             " Over the {} held-out samples the quality checks did not flag: RMSE {}, R² {:.4}. The two differ \
              because {flagged} held-out samples are flagged and {why}.",
-            held - flagged,
+            held.saturating_sub(flagged),
             with_unit(u.rmse, 4, unit),
             u.r2
         );
@@ -47,12 +47,14 @@ pub fn heldout_note(data: &Dataset, r: &FitResult, output: &str, unit: &str) -> 
 }
 
 /// Why the held-out RMSE is below the training RMSE: the parts' spreads, and the longest
-/// standstill of the input in the held-out part.
+/// standstill of the input in the held-out samples (of every run, in order).
 fn calmer_heldout(data: &Dataset, r: &FitResult, output: &str, unit: &str) -> String {
-    let split = data.train_end.min(data.len());
-    let (train, held) = data.output.split_at(split);
-    let (sd_t, sd_h) = (std(train), std(held));
-    let still = longest_still(&data.input[split..], span(&data.input)) as f64 * data.dt;
+    let rows = data.heldout_rows();
+    let pick = |v: &[f64], rows: &[usize]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
+    let train_rows: Vec<usize> = (0..data.len()).filter(|&i| data.is_train(i)).collect();
+    let (train, held) = (pick(&data.output, &train_rows), pick(&data.output, &rows));
+    let (sd_t, sd_h) = (std(&train), std(&held));
+    let still = longest_still(&pick(&data.input, &rows), span(&data.input)) as f64 * data.dt;
     let standstill = if still >= 0.5 {
         format!(
             " (the input stands still for {} of its {})",

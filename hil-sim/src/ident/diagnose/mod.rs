@@ -217,6 +217,7 @@ mod tests {
             excluded: vec![false; n],
             unusable: Vec::new(),
             rates: None,
+            runs: Vec::new(),
         }
     }
 

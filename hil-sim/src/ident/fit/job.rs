@@ -7,17 +7,18 @@ use std::time::Instant;
 use thiserror::Error;
 
 use super::{fit, FitError, FitOptions, FitResult};
-use crate::ident::dataset::{prepare, DatasetError, Prepared};
-use crate::io::params_file::ParamsFile;
-use crate::io::recording::Channels;
+use crate::ident::dataset::{DatasetError, Prepared};
+use crate::ident::runs::{prepare_runs, RunSpec, RunsError};
+use crate::io::params_file::{FittedChannels, ParamsFile};
 use crate::progress::Progress;
 
 /// What to fit, on what.
 #[derive(Clone, Debug)]
 pub struct FitJob {
-    pub recording: PathBuf,
-    pub channels: Channels,
-    /// Fraction of the recording (time-ordered, from the start) fitted; the rest is scored.
+    /// The recordings, each with its channels and role: one, or the runs of a dataset.
+    pub runs: Vec<RunSpec>,
+    /// Fraction of each recording (time-ordered, from the start) fitted; the rest is scored
+    /// (unless the dataset has `validate` runs).
     pub train: f64,
     /// Keep the samples the quality checks flag in the fit.
     pub keep_flagged: bool,
@@ -30,7 +31,10 @@ pub struct FitJob {
 /// The outcome of a [`FitJob`].
 #[derive(Clone, Debug)]
 pub struct FitRun {
+    /// The data fitted (a dataset's runs joined, [`crate::ident::dataset::Dataset::runs`]).
     pub prepared: Prepared,
+    /// Each recording's own preparation (one for a single recording).
+    pub runs: Vec<Prepared>,
     /// One per model, in the job's order.
     pub results: Vec<FitResult>,
     /// Parameter files written.
@@ -54,8 +58,10 @@ impl FitRun {
 pub enum FitJobError {
     #[error(transparent)]
     Dataset(#[from] DatasetError),
+    #[error(transparent)]
+    Runs(RunsError),
     #[error("fitting `{model}`")]
-    Fit { model: String, source: FitError },
+    Fit { model: String, source: Box<FitError> },
     #[error("{}: {reason}", path.display())]
     Save { path: PathBuf, reason: String },
 }
@@ -71,7 +77,9 @@ pub fn fit_many(
     let mut out = Vec::with_capacity(ids.len());
     for id in ids {
         progress.message(id);
-        out.push(fit(id, data, opts).map_err(|source| FitJobError::Fit { model: id.clone(), source })?);
+        out.push(
+            fit(id, data, opts).map_err(|source| FitJobError::Fit { model: id.clone(), source: Box::new(source) })?,
+        );
         progress.advance(1);
     }
     Ok(out)
@@ -79,27 +87,41 @@ pub fn fit_many(
 
 /// Run the job: prepare the recording, fit, save.
 pub fn run(job: &FitJob, progress: &dyn Progress) -> Result<FitRun, FitJobError> {
-    let prepared = prepare(&job.recording, &job.channels, job.train, job.keep_flagged)?;
+    let prepared = prepare_runs(&job.runs, job.train, job.keep_flagged).map_err(|e| match e {
+        RunsError::Dataset(d) => FitJobError::Dataset(d),
+        e => FitJobError::Runs(e),
+    })?;
     let t0 = Instant::now();
-    let results = fit_many(&prepared.data, &job.models, &job.options, progress)?;
+    let results = fit_many(&prepared.joined.data, &job.models, &job.options, progress)?;
     let total_seconds = t0.elapsed().as_secs_f64();
-    let saved = match &job.save {
-        Some(dir) => save(dir, &results, &job.recording)?,
-        None => Vec::new(),
+    let saved = match (&job.save, job.runs.first()) {
+        (Some(dir), Some(first)) => {
+            let files: Vec<&Path> = job.runs.iter().map(|r| r.path.as_path()).collect();
+            save(dir, &results, &files, &FittedChannels::of(&first.channels))?
+        }
+        _ => Vec::new(),
     };
-    Ok(FitRun { prepared, results, saved, total_seconds })
+    Ok(FitRun { prepared: prepared.joined, runs: prepared.runs, results, saved, total_seconds })
 }
 
-/// Write each result as `<dir>/<model>.json`, a `replay --params` file naming its source.
-pub fn save(dir: &Path, results: &[FitResult], recording: &Path) -> Result<Vec<PathBuf>, FitJobError> {
+/// Write each result as `<dir>/<model>.json`, a `replay --params` file naming its source
+/// recordings and the channels it was fitted on.
+pub fn save(
+    dir: &Path,
+    results: &[FitResult],
+    recordings: &[&Path],
+    channels: &FittedChannels,
+) -> Result<Vec<PathBuf>, FitJobError> {
     let err = |path: &Path, reason: String| FitJobError::Save { path: path.to_owned(), reason };
     crate::io::output::create_dir(dir).map_err(|e| err(dir, e.to_string()))?;
     let mut written = Vec::with_capacity(results.len());
     for r in results {
         let file = dir.join(format!("{}.json", r.model));
         let flat: Vec<f32> = r.flat.iter().map(|v| *v as f32).collect();
-        let mut pf = ParamsFile::from_flat(&r.model, Some(format!("hil-sim fit {}", recording.display())), &flat)
+        let names: Vec<String> = recordings.iter().map(|p| p.display().to_string()).collect();
+        let mut pf = ParamsFile::from_flat(&r.model, Some(format!("hil-sim fit {}", names.join(" "))), &flat)
             .ok_or_else(|| err(&file, "cannot build the parameter file".into()))?;
+        pf.channels = Some(channels.clone());
         pf.rate = Some(r.rate.clone());
         pf.delay_s = (r.delay_s != 0.0).then_some(r.delay_s);
         pf.command_delay_s = (r.command_delay_s != 0.0).then_some(r.command_delay_s);

@@ -15,7 +15,9 @@
 //! - [`fit`] returns the parameters and all metrics of the contract, train and held-out,
 //!   from a replay through [`crate::models::replay()`] — the `Estimator` path, f32.
 
+pub mod confidence;
 pub mod global;
+pub mod identifiable;
 pub mod job;
 pub mod linear;
 pub mod lm;
@@ -23,6 +25,8 @@ pub mod narx;
 pub mod narx_net;
 pub mod objective;
 pub mod operator;
+mod per_run;
+pub mod restarts;
 pub mod simulate;
 
 use std::time::Instant;
@@ -33,13 +37,15 @@ use thiserror::Error;
 
 use crate::io::params_file::{ParamsFile, Values};
 use crate::models::search::{ModelSpec, Scales, Strategy, Structure};
-use crate::models::{replay, RateSpec};
+use crate::models::RateSpec;
 use crate::numerics::derivative::gradient;
 use crate::numerics::metrics::{metrics, Metrics};
 use global::SwarmOptions;
 
 pub use crate::ident::dataset::{Dataset, DatasetError};
 use objective::Objective;
+use per_run::per_run_metrics;
+pub use per_run::RunMetrics;
 
 /// Both parts keep samples to score under the delays `ds` (samples, step `dt` s).
 fn scored_parts(train: &[usize], heldout: &[usize], ds: (f64, f64), dt: f64) -> Result<(), FitError> {
@@ -153,6 +159,9 @@ pub struct FitResult {
     pub state_bytes: usize,
     /// Samples whose output the core held (non-finite or overflow) in the replay.
     pub held: usize,
+    /// Each run's metrics, for a dataset of several recordings (empty for one).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub runs: Vec<RunMetrics>,
     /// What the fit noticed about the fitted set (e.g. a non-physical crossing loop of the
     /// asymmetric Bouc–Wen model, seed 004 on eq. 30).
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -167,20 +176,52 @@ pub struct FitResult {
     pub output: Vec<f64>,
 }
 
-/// Fit model `id` to `data`.
+/// Fit model `id` to `data`. A fitted delay that ends at the edge of its search range is
+/// held at zero and the model refitted, with a warning ([`identifiable`]).
 pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, FitError> {
+    let first = fit_once(id, data, opts)?;
+    let dt = data.dt;
+    let (d, d_u) = (first.delay_s / dt, first.command_delay_s / dt);
+    let (edge_x, edge_u) = (identifiable::at_edge(d), identifiable::at_edge(d_u));
+    if opts.delay != DelayChoice::Auto || !(edge_x || edge_u) {
+        return Ok(first);
+    }
+    let mut which = Vec::new();
+    if edge_x {
+        which.push(("input", d));
+    }
+    if edge_u {
+        which.push(("command", d_u));
+    }
+    let held =
+        DelayChoice::Fixed(if edge_x { 0.0 } else { first.delay_s }, if edge_u { 0.0 } else { first.command_delay_s });
+    let mut r = fit_once(id, data, &FitOptions { delay: held, ..*opts })?;
+    r.warnings.insert(0, identifiable::edge_warning(&which, dt));
+    r.fit_seconds += first.fit_seconds;
+    r.evaluations += first.evaluations;
+    Ok(r)
+}
+
+/// [`fit`] without the check of the delays.
+fn fit_once(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, FitError> {
     let info = model_core::registry::find(id).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
-    let scales = data.scales();
+    // A command that never changes cannot identify the terms it drives: fit the model's
+    // no-command form (those terms held) and say so.
+    let constant_u = identifiable::constant_command(data);
+    let scales = Scales { u: data.scales().u.filter(|_| constant_u.is_none()), ..data.scales() };
     let host = crate::models::host(id).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
     let sp = host.spec(&scales, opts.rate).ok_or_else(|| FitError::NotFittable(id.to_owned()))?;
     let started = Instant::now();
     let dt = data.dt as f32;
     let samples = data.samples();
-    let kin = simulate::kinematics(&samples, dt, sp.rate).ok_or(FitError::RateOverflow { model: id.to_owned() })?;
-    let sim = simulate::simulator(id, dt).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
+    let starts = data.run_starts();
+    let kin = simulate::kinematics_runs(&samples, dt, sp.rate, &starts)
+        .ok_or(FitError::RateOverflow { model: id.to_owned() })?;
+    let sim = simulate::simulator_runs(id, dt, &starts).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
     let rows = data.train_rows();
+    let notes = restarts::Notes::default();
     let fit_at = |kin: &[model_core::Kin], sp: &ModelSpec| {
-        identify_variants(id, sp, sim.as_ref(), kin, &data.output, &rows, &scales, opts)
+        identify_variants(id, sp, sim.as_ref(), kin, &data.output, &rows, &scales, opts, &notes)
     };
     let n_model = sim.n_params();
     let ((mut params, evaluations), (delay, delay_u)) = match (opts.delay, sp.strategy) {
@@ -189,13 +230,13 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
             let d = (s / data.dt, if data.command.is_some() { s_u / data.dt } else { 0.0 });
             crate::models::alignment::check(data.len(), data.dt, &[d.0, d.1])?;
             let mut shifted = Vec::new();
-            crate::models::alignment::shift_kin(&kin, d.0, d.1, &mut shifted);
+            crate::models::alignment::shift_kin_runs(&kin, d.0, d.1, &starts, &mut shifted);
             (fit_at(&shifted, &sp)?, d)
         }
         // A network has past inputs for the lags it needs.
         (DelayChoice::Auto, Strategy::Network) => (fit_at(&kin, &sp)?, (0.0, 0.0)),
         (DelayChoice::Auto, Strategy::Linear | Strategy::Operator) => {
-            let found = scan_delay(&kin, |k| {
+            let found = scan_delay(&kin, &starts, |k| {
                 let r = fit_at(k, &sp).ok()?;
                 let cost = Objective::new(sim.as_ref(), &sp, k, &data.output, &rows, scales.y).cost(&r.0);
                 Some((r, cost))
@@ -215,51 +256,47 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     };
     params.truncate(n_model);
     let fit_seconds = started.elapsed().as_secs_f64();
-    let mut warnings = Vec::new();
+    let mut warnings: Vec<String> = identifiable::constant_command_note(id, data, constant_u).into_iter().collect();
+    warnings.extend(notes.into_inner().unwrap_or_default());
+    let ds = (delay, delay_u);
     if sp.structure == Structure::AsymmetricBoucWen {
-        let mut shifted = Vec::new();
-        crate::models::alignment::shift_kin(&kin, delay, delay_u, &mut shifted);
-        if operator::abw_crossing(&params, dt, &shifted, &rows) == Some(true) {
-            let eq = if params.get(11).copied() == Some(1.0) { "eq. 30" } else { "eq. 31" };
-            warnings.push(format!(
-                "bouc_wen_asym ({eq}): the fitted loop crosses itself over the training range at the data's mean \
-                 rate, a non-physical artefact (seed 004 §6.2); do not use this set for control"
-            ));
-        }
+        warnings.extend(operator::abw_warning(&params, dt, &kin, ds, &starts, &rows));
+    }
+    if matches!(sp.strategy, Strategy::Global | Strategy::Local) {
+        warnings.extend(confidence::check(
+            sim.as_ref(),
+            &sp,
+            &kin,
+            &data.output,
+            &rows,
+            scales.y,
+            ds,
+            &starts,
+            &params,
+        ));
     }
 
     // Score with the Estimator path, the firmware's code, over the whole recording.
     let p32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
-    // The channels as the model saw them (as recorded when no delay was fitted).
-    let (input, command) =
-        crate::models::alignment::shift_channels(&data.input, data.command.as_deref(), delay, delay_u);
-    let samples = if delay == 0.0 && delay_u == 0.0 {
-        samples
-    } else {
-        let rates = data
-            .rates
-            .as_ref()
-            .map(|(dx, ddx)| (crate::models::alignment::shift(dx, delay), crate::models::alignment::shift(ddx, delay)));
-        crate::models::replay::samples_with_rates(&input, command.as_deref(), rates.as_ref())
-    };
+    let (input, samples) = as_seen(data, samples, (delay, delay_u), &starts);
     let t0 = Instant::now();
-    let rep = replay(id, &p32, dt, sp.rate, &samples)
+    let rep = crate::models::replay::replay_runs(id, &p32, dt, sp.rate, &samples, &starts)
         .map_err(|e| FitError::Replay { model: id.to_owned(), reason: e.to_string() })?;
     let replay_ns = t0.elapsed().as_secs_f64() * 1e9 / samples.len().max(1) as f64;
     let output: Vec<f64> = rep.y.iter().map(|v| f64::from(*v)).collect();
-    let dx = gradient(&input, data.dt);
-    let ddx = gradient(&dx, data.dt);
+    let dx = data.per_run(&input, |v| gradient(v, data.dt));
+    let ddx = data.per_run(&dx, |v| gradient(v, data.dt));
     let score = |rows: &[usize]| {
         let pick = |v: &[f64]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
         metrics(&pick(&data.output), &pick(&output), Some((&pick(&dx), &pick(&ddx))))
     };
-    // A delayed channel has no data for the first or last few samples: those are not scored.
-    let n = data.len();
-    let (lo, hi) = crate::models::alignment::covered(n, &[delay, delay_u]);
-    let unflagged: Vec<usize> = data.heldout_unflagged().into_iter().filter(|i| (lo..hi).contains(i)).collect();
-    let all_heldout: Vec<usize> = (data.train_end..n).filter(|&i| (lo..hi).contains(&i) && data.usable(i)).collect();
-    let rows: Vec<usize> = rows.into_iter().filter(|i| (lo..hi).contains(i)).collect();
+    // A delayed channel has no data for the first or last few samples of a run: those are not scored.
+    let ds = [delay, delay_u];
+    let unflagged = data.covered(&data.heldout_unflagged(), &ds);
+    let all_heldout = data.covered(&data.heldout_rows(), &ds);
+    let rows = data.covered(&rows, &ds);
     scored_parts(&rows, &all_heldout, (delay, delay_u), data.dt)?;
+    let runs = per_run_metrics(data, &rows, &all_heldout, &score);
     let named = ParamsFile::from_flat(id, None, &p32).map(|f| f.params).unwrap_or(Values::Flat(params.clone()));
     Ok(FitResult {
         model: id.to_owned(),
@@ -278,11 +315,31 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
         free_params: sp.free().len() + operator::projected_count(sp.structure),
         state_bytes: info.state_bytes,
         held: rep.held,
+        runs,
         warnings,
         flat: params,
         rate_choice: sp.rate,
         output,
     })
+}
+
+/// The input and the samples as the model saw them: shifted by the fitted delays within each
+/// run (`samples`, as recorded, when there are none).
+fn as_seen(
+    data: &Dataset,
+    samples: Vec<model_core::Sample>,
+    (delay, delay_u): (f64, f64),
+    starts: &[usize],
+) -> (Vec<f64>, Vec<model_core::Sample>) {
+    let shift = |v: &[f64], d: f64| crate::models::alignment::shift_runs(v, d, starts);
+    let input = shift(&data.input, delay);
+    if delay == 0.0 && delay_u == 0.0 {
+        return (input, samples);
+    }
+    let command = data.command.as_deref().map(|u| shift(u, delay_u));
+    let rates = data.rates.as_ref().map(|(dx, ddx)| (shift(dx, delay), shift(ddx, delay)));
+    let samples = crate::models::replay::samples_with_rates(&input, command.as_deref(), rates.as_ref());
+    (input, samples)
 }
 
 /// Whether model `id` has a command-dependent parameter the fit frees (its spec fixes more
@@ -304,6 +361,7 @@ fn identify_variants(
     rows: &[usize],
     scales: &Scales,
     opts: &FitOptions,
+    notes: &restarts::Notes,
 ) -> Result<(Vec<f64>, usize), FitError> {
     let mut best: Option<(Vec<f64>, usize, f64)> = None;
     let mut evals = 0;
@@ -311,7 +369,7 @@ fn identify_variants(
     let mut k = 0;
     let mut current = Some(sp.clone());
     while let Some(v) = current {
-        match identify(id, &v, sim, kin, y, rows, scales.y, opts) {
+        match identify(id, &v, sim, kin, y, rows, scales.y, opts, notes) {
             Ok((p, e)) => {
                 evals += e;
                 let cost = Objective::new(sim, &v, kin, y, rows, scales.y).cost(&p);
@@ -342,6 +400,7 @@ fn identify(
     rows: &[usize],
     y_scale: f64,
     opts: &FitOptions,
+    notes: &restarts::Notes,
 ) -> Result<(Vec<f64>, usize), FitError> {
     let full = Objective::new(sim, sp, kin, y, rows, y_scale);
     match sp.strategy {
@@ -381,7 +440,7 @@ fn identify(
                     (p.lo, p.hi, p.start) = (v, v, v);
                 }
             }
-            let (p, evals) = identify(id, &shape, &proj, kin, y, rows, y_scale, opts)?;
+            let (p, evals) = identify(id, &shape, &proj, kin, y, rows, y_scale, opts, notes)?;
             let full = proj.complete(&p, kin).ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
             valid_or_err(id, sim, full, evals)
         }
@@ -392,26 +451,56 @@ fn identify(
             // per weight per Jacobian) to a few seconds on the Dyke files; NARX has its own
             // ([`narx_net::Effort`]).
             let (iterations, window) = (3 * opts.lm_iterations.max(1), opts.swarm_window.min(6000));
-            let t = narx::train(sp.structure, kin, y, rows, 1e-3, sp.rate, iterations, window, opts.swarm.seed)
-                .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
-            valid_or_err(id, sim, t.params, t.evaluations)
+            let mut evals = 0;
+            // Hammerstein–Wiener's training depends on its random start (seed 1 and 2 can end
+            // far apart); NARX's own effort schedule is kept to one start for its cost.
+            let starts = if sp.structure == Structure::HammersteinWiener { restarts::MAX_STARTS } else { 1 };
+            let t = restarts::until_agree(&format!("the {id} training"), opts.swarm.seed, starts, notes, |seed| {
+                let t = narx::train(sp.structure, kin, y, rows, 1e-3, sp.rate, iterations, window, seed)?;
+                evals += t.evaluations;
+                let cost = full.cost(&t.params);
+                Some((t.params, cost))
+            })
+            .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
+            valid_or_err(id, sim, t, evals)
         }
         Strategy::Global => {
             let window_rows: Vec<usize> = rows.iter().copied().filter(|&i| i < opts.swarm_window).collect();
             let window_rows = if window_rows.len() < 20 { rows.to_vec() } else { window_rows };
             let win = Objective::new(sim, sp, kin, y, &window_rows, y_scale);
-            let first = global_search(id, sp, &win, &full, opts, opts.swarm)?;
-            // A box where the small swarm found nothing valid (a start that is not a
-            // published set, a narrow valid region) gets a wider search before giving up.
-            let (best, mut evals) = match first {
-                (Some(best), evals) => (best, evals),
-                (None, evals) => {
-                    let wide = SwarmOptions::wide(opts.swarm.seed);
-                    match global_search(id, sp, &win, &full, opts, wide)? {
-                        (Some(best), more) => (best, evals + more),
-                        (None, _) => return Err(FitError::NoValidSet { model: id.to_owned() }),
+            let mut evals = 0;
+            let mut failure = None;
+            let best = restarts::until_agree(
+                &format!("the {id} global search"),
+                opts.swarm.seed,
+                restarts::MAX_STARTS,
+                notes,
+                |seed| {
+                    let swarm = SwarmOptions { seed, ..opts.swarm };
+                    let r = global_search(id, sp, &win, &full, opts, swarm).and_then(|first| match first {
+                        (Some(best), e) => Ok((Some(best), e)),
+                        // A box where the small swarm found nothing valid (a start that is not a
+                        // published set, a narrow valid region) gets a wider search before giving up.
+                        (None, e) => global_search(id, sp, &win, &full, opts, SwarmOptions::wide(seed))
+                            .map(|(b, more)| (b, e + more)),
+                    });
+                    match r {
+                        Ok((b, e)) => {
+                            evals += e;
+                            b.map(|b| {
+                                let c = b.cost;
+                                (b, c)
+                            })
+                        }
+                        Err(e) => {
+                            failure = failure.take().or(Some(e));
+                            None
+                        }
                     }
-                }
+                },
+            );
+            let Some(best) = best else {
+                return Err(failure.unwrap_or_else(|| FitError::NoValidSet { model: id.to_owned() }));
             };
             let r = lm::minimize(&full, &best.params, opts.lm_iterations);
             evals += r.evaluations;
@@ -462,6 +551,7 @@ fn global_search(
 /// its delay in samples. For the closed-form models, where a fit costs one pass.
 fn scan_delay<T>(
     kin: &[model_core::Kin],
+    starts: &[usize],
     at: impl Fn(&[model_core::Kin]) -> Option<(T, f64)> + Sync,
 ) -> Option<(T, f64)>
 where
@@ -470,7 +560,7 @@ where
     let m = crate::models::alignment::MAX_DELAY_SAMPLES as i32;
     let fit_shifted = |d: f64| {
         let mut shifted = Vec::new();
-        crate::models::alignment::shift_kin(kin, d, 0.0, &mut shifted);
+        crate::models::alignment::shift_kin_runs(kin, d, 0.0, starts, &mut shifted);
         at(&shifted).map(|(r, c)| (r, c, d))
     };
     let mut grid: Vec<Option<(T, f64, f64)>> = (-m..=m).into_par_iter().map(|d| fit_shifted(f64::from(d))).collect();
@@ -505,75 +595,4 @@ fn valid_or_err(
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::models::replay;
-
-    /// A recording of `id` with `truth`, whose input channel was logged `lag` samples late.
-    fn lagged(id: &str, truth: &[f32], lag: f64, command: bool) -> Dataset {
-        let dt = 1e-3;
-        let n = 6000;
-        let time: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
-        let x_true: Vec<f64> = time
-            .iter()
-            .map(|t| (2.0 * std::f64::consts::PI * 3.0 * t).sin() + 0.4 * (2.0 * std::f64::consts::PI * 11.0 * t).sin())
-            .collect();
-        let u = command.then(|| time.iter().map(|t| 1.0 + 0.8 * (3.1 * t).sin()).collect::<Vec<f64>>());
-        let samples = crate::models::replay::samples(&x_true, u.as_deref());
-        let out = replay(id, truth, dt as f32, RateSpec::Backward, &samples).unwrap();
-        // The logged input is the true one `lag` samples late: x_log(t) = x_true(t − lag).
-        let input = crate::models::alignment::shift(&x_true, -lag);
-        Dataset {
-            dt,
-            time,
-            input,
-            output: out.y.iter().map(|v| f64::from(*v)).collect(),
-            command: u,
-            train_end: 4200,
-            excluded: vec![false; n],
-            unusable: Vec::new(),
-            rates: None,
-        }
-    }
-
-    fn opts(delay: DelayChoice) -> FitOptions {
-        // Noiseless data: let Levenberg–Marquardt run to convergence.
-        FitOptions {
-            rate: Some(RateSpec::Backward),
-            delay,
-            lm_iterations: 80,
-            polish_iterations: 80,
-            ..FitOptions::default()
-        }
-    }
-
-    #[test]
-    fn closed_form_fit_finds_a_known_input_delay() {
-        let data = lagged("algebraic", &[2.0, 0.05, -0.3, 0.1], 3.0, false);
-        let auto = fit("algebraic", &data, &opts(DelayChoice::Auto)).unwrap();
-        let off = fit("algebraic", &data, &opts(DelayChoice::Off)).unwrap();
-        assert!((auto.delay_s - 3e-3).abs() < 0.3e-3, "delay {} s", auto.delay_s);
-        assert_eq!(off.delay_s, 0.0);
-        assert!(auto.heldout.rmse < 1e-3 * off.heldout.rmse, "{} vs {}", auto.heldout.rmse, off.heldout.rmse);
-    }
-
-    #[test]
-    fn iterative_fit_finds_a_known_input_delay() {
-        let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
-        let data = lagged("bouc_wen", &truth, -2.5, false);
-        let auto = fit("bouc_wen", &data, &opts(DelayChoice::Auto)).unwrap();
-        let off = fit("bouc_wen", &data, &opts(DelayChoice::Off)).unwrap();
-        assert!(
-            (auto.delay_s + 2.5e-3).abs() < 0.5e-3,
-            "delay {} s, rmse {} vs {}",
-            auto.delay_s,
-            auto.train.rmse,
-            off.train.rmse
-        );
-        assert_eq!(auto.command_delay_s, 0.0, "no command channel, no command delay");
-        assert!(auto.train.rmse < off.train.rmse, "{} vs {}", auto.train.rmse, off.train.rmse);
-        // A given delay is used as given.
-        let fixed = fit("bouc_wen", &data, &opts(DelayChoice::Fixed(-2.5e-3, 0.0))).unwrap();
-        assert!((fixed.delay_s + 2.5e-3).abs() < 1e-12);
-    }
-}
+mod tests;

@@ -6,7 +6,7 @@ use std::sync::{Arc, Mutex};
 use model_core::Kin;
 
 use super::simulate::Simulator;
-use crate::models::alignment::{shift_kin, MAX_DELAY_SAMPLES};
+use crate::models::alignment::{shift_kin_runs, MAX_DELAY_SAMPLES};
 use crate::models::search::ModelSpec;
 
 /// Kinematics shifted by an (input, command) delay pair, in samples.
@@ -114,7 +114,7 @@ impl<'a> Objective<'a> {
             }
         }
         let mut shifted = Vec::with_capacity(self.kin.len());
-        shift_kin(self.kin, d, d_u, &mut shifted);
+        shift_kin_runs(self.kin, d, d_u, self.sim.run_starts(), &mut shifted);
         let shifted = Arc::new(shifted);
         if let Ok(mut cache) = self.shifted.lock() {
             *cache = Some(((d, d_u), Arc::clone(&shifted)));

@@ -352,6 +352,26 @@ pub fn abw_crossing(flat: &[f64], dt: f32, kin: &[Kin], rows: &[usize]) -> Optio
     Some(m.crossing_risk(lo as f32, hi as f32, rate as f32))
 }
 
+/// The asymmetric Bouc–Wen set's non-physical crossing loop (seed 004 §6.2), if it has one.
+pub fn abw_warning(
+    params: &[f64],
+    dt: f32,
+    kin: &[model_core::Kin],
+    delays: (f64, f64),
+    starts: &[usize],
+    rows: &[usize],
+) -> Option<String> {
+    let mut shifted = Vec::new();
+    crate::models::alignment::shift_kin_runs(kin, delays.0, delays.1, starts, &mut shifted);
+    (abw_crossing(params, dt, &shifted, rows) == Some(true)).then(|| {
+        let eq = if params.get(11).copied() == Some(1.0) { "eq. 30" } else { "eq. 31" };
+        format!(
+            "bouc_wen_asym ({eq}): the fitted loop crosses itself over the training range at the data's mean \
+             rate, a non-physical artefact (seed 004 §6.2); do not use this set for control"
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -18,12 +18,19 @@ pub trait Simulator: Send + Sync {
     /// Whether `p` is a valid parameter set (the model's own constructor decides).
     fn valid(&self, p: &[f64]) -> bool;
     /// Run from rest over `kin`, writing one output per sample into `out`. `false` when the
-    /// parameters are invalid or the output stops being finite.
+    /// parameters are invalid or the output stops being finite. The state restarts at every
+    /// run start ([`Simulator::run_starts`]).
     fn run(&self, p: &[f64], kin: &[Kin], out: &mut [f64]) -> bool;
+    /// Where the runs of a dataset start (sample indices); empty or `[0]` for one recording.
+    fn run_starts(&self) -> &[usize] {
+        &[]
+    }
 }
 
 struct Sim<M> {
     dt: f32,
+    /// Run starts after the first (the state restarts there).
+    starts: Vec<usize>,
     _m: PhantomData<fn() -> M>,
 }
 
@@ -43,46 +50,69 @@ impl<M: Model> Simulator for Sim<M> {
     }
     fn run(&self, p: &[f64], kin: &[Kin], out: &mut [f64]) -> bool {
         let Ok(model) = M::from_params(&to_f32(p), self.dt) else { return false };
-        let Some(first) = kin.first() else { return true };
-        let mut st = model.initial_state(first);
-        for (k, o) in kin.iter().zip(out.iter_mut()) {
-            let y = model.step(&mut st, k);
-            if !y.is_finite() {
-                return false;
+        let n = kin.len().min(out.len());
+        let mut a = 0;
+        for b in self.starts.iter().copied().filter(|&s| s > 0 && s < n).chain([n]) {
+            let (Some(seg), Some(o)) = (kin.get(a..b), out.get_mut(a..b)) else { return false };
+            let Some(first) = seg.first() else { continue };
+            let mut st = model.initial_state(first);
+            for (k, o) in seg.iter().zip(o.iter_mut()) {
+                let y = model.step(&mut st, k);
+                if !y.is_finite() {
+                    return false;
+                }
+                *o = f64::from(y);
             }
-            *o = f64::from(y);
+            a = b;
         }
         true
     }
+    fn run_starts(&self) -> &[usize] {
+        &self.starts
+    }
 }
 
-struct Make(f32);
+struct Make(f32, Vec<usize>);
 impl Visit for Make {
     type Out = Box<dyn Simulator>;
     fn visit<M: Model>(self) -> Box<dyn Simulator> {
-        Box::new(Sim::<M> { dt: self.0, _m: PhantomData })
+        Box::new(Sim::<M> { dt: self.0, starts: self.1, _m: PhantomData })
     }
 }
 
 /// The simulator of model `id` at step `dt` seconds; `None` for an unknown id.
 pub fn simulator(id: &str, dt: f32) -> Option<Box<dyn Simulator>> {
-    visit(id, Make(dt))
+    visit(id, Make(dt, Vec::new()))
+}
+
+/// [`simulator`] for a dataset whose runs start at `starts` (sample indices): the state
+/// restarts at each.
+pub fn simulator_runs(id: &str, dt: f32, starts: &[usize]) -> Option<Box<dyn Simulator>> {
+    visit(id, Make(dt, starts.to_vec()))
 }
 
 /// The simulator of a model type that is not in the registry (e.g. a smaller size of a
 /// const-generic model, trained before it is written into the registered size).
 pub fn simulator_of<M: Model>(dt: f32) -> Box<dyn Simulator> {
-    Box::new(Sim::<M> { dt, _m: PhantomData })
+    Box::new(Sim::<M> { dt, starts: Vec::new(), _m: PhantomData })
 }
 
 /// The kinematics the core sees for each sample, from the rate estimator `rate` exactly as
 /// [`model_core::Estimator::step`] computes them (a measured rate in the sample wins).
 /// `None` if the estimate overflows (the inputs are checked finite before).
 pub fn kinematics(samples: &[Sample], dt: f32, rate: RateSpec) -> Option<Vec<Kin>> {
+    kinematics_runs(samples, dt, rate, &[])
+}
+
+/// [`kinematics`] with the estimator restarted at every run start in `starts`.
+pub fn kinematics_runs(samples: &[Sample], dt: f32, rate: RateSpec, starts: &[usize]) -> Option<Vec<Kin>> {
     let params = rate.build(dt).ok()?;
     let mut st = RateState::default();
     let mut out = Vec::with_capacity(samples.len());
-    for s in samples {
+    for (i, s) in samples.iter().enumerate() {
+        if i > 0 && starts.contains(&i) {
+            st = RateState::default();
+        }
         let (dx, ddx) = params.step(&mut st, s.x);
         let k = Kin { x: s.x, dx: s.dx.unwrap_or(dx), ddx: s.ddx.unwrap_or(ddx), u: s.u.unwrap_or(0.0) };
         if !k.is_finite() {

@@ -10,7 +10,7 @@
 use std::io::Read;
 use std::path::Path;
 
-use super::{Column, Format, Recording, RecordingError};
+use super::RecordingError;
 
 /// What reading a MAT-file may hold in memory beyond the file itself (bytes): 24 MiB and
 /// four times the file's size, for the values read as f64 and the compressed element being
@@ -126,17 +126,27 @@ impl<'a> Cursor<'a> {
 }
 
 /// A variable as stored.
-struct Variable {
-    name: String,
-    dims: Vec<u64>,
-    kind: Kind,
+pub(super) struct Variable {
+    pub name: String,
+    pub dims: Vec<u64>,
+    pub kind: Kind,
 }
 
-enum Kind {
+pub(super) enum Kind {
     Numeric(Vec<f64>),
+    /// A char array, as text.
+    Text(String),
+    /// A struct (array): field names, then one row of field values per element.
+    Struct {
+        fields: Vec<String>,
+        elements: Vec<Vec<Variable>>,
+    },
     Complex,
     Other(&'static str),
 }
+
+/// Nesting deeper than this (structs in structs) is refused: no recording needs it.
+const MAX_DEPTH: u32 = 8;
 
 fn class_name(class: u8) -> &'static str {
     match class {
@@ -205,7 +215,7 @@ fn numbers(t: u32, data: &[u8], e: Endian, at: usize) -> R<Vec<f64>> {
 /// The payload of an miMATRIX element.
 /// `left`: the memory budget left; the values' declared size (as f64) is charged to it
 /// before they are read.
-fn matrix(data: &[u8], base: usize, e: Endian, left: &mut u64) -> R<Variable> {
+fn matrix(data: &[u8], base: usize, e: Endian, left: &mut u64, depth: u32) -> R<Variable> {
     let mut c = Cursor { buf: data, pos: 0, base, e };
     let (t, flags, at) = c.element()?;
     if t != MI_UINT32 || flags.len() != 8 {
@@ -238,12 +248,67 @@ fn matrix(data: &[u8], base: usize, e: Endian, left: &mut u64) -> R<Variable> {
         6..=15 if complex => Kind::Complex,
         6..=15 => {
             charge(&name, &dims, left, base)?;
-            let (t, re, at) = c.element()?;
-            Kind::Numeric(numbers(t, re, e, at)?)
+            if dims.contains(&0) && c.at_end() {
+                Kind::Numeric(Vec::new())
+            } else {
+                let (t, re, at) = c.element()?;
+                Kind::Numeric(numbers(t, re, e, at)?)
+            }
         }
+        4 => {
+            charge(&name, &dims, left, base)?;
+            let text = if c.at_end() {
+                String::new()
+            } else {
+                let (t, re, at) = c.element()?;
+                numbers(t, re, e, at)?.into_iter().filter_map(|v| char::from_u32(v as u32)).collect()
+            };
+            Kind::Text(text.trim_end_matches(['\0', ' ']).to_owned())
+        }
+        2 if depth < MAX_DEPTH => structure(&mut c, &dims, base, e, left, depth)?,
         other => Kind::Other(class_name(other)),
     };
     Ok(Variable { name, dims, kind })
+}
+
+/// The rest of a struct array's payload: field names, then each element's fields as
+/// (unnamed) nested arrays.
+fn structure(c: &mut Cursor<'_>, dims: &[u64], base: usize, e: Endian, left: &mut u64, depth: u32) -> R<Kind> {
+    let (t, len, at) = c.element()?;
+    let width = numbers(t, len, e, at)?.first().copied().unwrap_or(0.0) as usize;
+    if width == 0 || width > 64 {
+        return Err(Fault::Format(format!("struct at byte {base}: field-name length {width} at byte {at}")));
+    }
+    let (_, names, _) = c.element()?;
+    let fields: Vec<String> = names
+        .chunks(width)
+        .map(|n| String::from_utf8_lossy(n).trim_end_matches('\0').chars().flat_map(char::escape_default).collect())
+        .collect();
+    let count = dims.iter().try_fold(1u64, |a, &d| a.checked_mul(d)).unwrap_or(u64::MAX);
+    let cells = count.saturating_mul(fields.len() as u64);
+    // Each nested array costs at least its 8-byte tag: a count the payload cannot hold is corrupt.
+    if cells.saturating_mul(8) > (c.buf.len() - c.pos.min(c.buf.len())) as u64 {
+        return Err(Fault::Format(format!("struct at byte {base}: {cells} fields do not fit in its data")));
+    }
+    let mut elements = Vec::with_capacity(count as usize);
+    for _ in 0..count {
+        let mut row = Vec::with_capacity(fields.len());
+        for f in &fields {
+            let (t, data, at) = c.element()?;
+            if t != MI_MATRIX {
+                return Err(Fault::Format(format!("struct field `{f}` at byte {at} is {}", type_name(t))));
+            }
+            let mut v = if data.is_empty() {
+                Variable { name: String::new(), dims: vec![0, 0], kind: Kind::Numeric(Vec::new()) }
+            } else {
+                matrix(data, at + 8, e, left, depth + 1)?
+            };
+            v.name.clone_from(f);
+            row.push(v);
+        }
+        elements.push(row);
+    }
+    Ok(Kind::Struct { fields, elements })
 }
 
 /// Inflate the array a compressed element holds: its tag (the first 8 bytes) declares the
@@ -317,7 +382,7 @@ fn variables(bytes: &[u8]) -> R<Vec<Variable>> {
         let (t, data, at) = body.element()?;
         match t {
             MI_MATRIX => {
-                out.push(matrix(data, at + 8, e, &mut left)?);
+                out.push(matrix(data, at + 8, e, &mut left, 0)?);
             }
             MI_COMPRESSED => {
                 // The inflated bytes are charged while they live, then given back.
@@ -326,7 +391,7 @@ fn variables(bytes: &[u8]) -> R<Vec<Variable>> {
                 left -= held.min(left);
                 let mut c = Cursor { buf: &inner, pos: 0, base: at + 8, e };
                 let (_, data, _) = c.element()?;
-                out.push(matrix(data, at + 8, e, &mut left)?);
+                out.push(matrix(data, at + 8, e, &mut left, 0)?);
                 drop(inner);
                 left += held;
             }
@@ -341,78 +406,18 @@ fn variables(bytes: &[u8]) -> R<Vec<Variable>> {
     Ok(out)
 }
 
-fn shape(dims: &[u64]) -> String {
+pub(super) fn shape(dims: &[u64]) -> String {
     dims.iter().map(u64::to_string).collect::<Vec<_>>().join("×")
 }
 
-/// Parse level-5 MAT bytes; `path` is used in messages only.
-pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Recording, RecordingError> {
+/// The variables of level-5 MAT bytes, in file order; `path` is used in messages only.
+pub(super) fn read(path: &Path, bytes: &[u8]) -> Result<Vec<Variable>, RecordingError> {
     let p = || path.to_path_buf();
     if bytes.is_empty() {
         return Err(RecordingError::Empty { path: p() });
     }
-    let vars = variables(bytes).map_err(|f| match f {
+    variables(bytes).map_err(|f| match f {
         Fault::Truncated(offset) => RecordingError::MatTruncated { path: p(), offset, size: bytes.len() },
         Fault::Format(reason) => RecordingError::MatFormat { path: p(), reason },
-    })?;
-    let bad =
-        |v: &Variable, reason: String| RecordingError::MatVariable { path: p(), variable: v.name.clone(), reason };
-    let mut columns: Vec<Column> = Vec::new();
-    let mut constants: Vec<(String, f64)> = Vec::new();
-    for v in &vars {
-        if columns.iter().any(|c| c.name == v.name) || constants.iter().any(|c| c.0 == v.name) {
-            return Err(bad(v, "appears twice".into()));
-        }
-        let values = match &v.kind {
-            Kind::Numeric(values) => values,
-            Kind::Complex => return Err(bad(v, "is complex; channels must be real".into())),
-            Kind::Other(what) => {
-                return Err(bad(v, format!("is {what}; only numeric vectors and scalars are read")));
-            }
-        };
-        let count = v.dims.iter().try_fold(1u64, |a, &d| a.checked_mul(d));
-        if count != Some(values.len() as u64) {
-            return Err(bad(v, format!("is {} but holds {} values", shape(&v.dims), values.len())));
-        }
-        let long = v.dims.iter().filter(|&&d| d != 1).count();
-        if values.is_empty() {
-            return Err(bad(v, format!("is empty ({})", shape(&v.dims))));
-        }
-        let scalar = match (values.len(), long, v.dims.len()) {
-            (1, _, _) => true,
-            (_, 1, 2) => false,
-            (_, _, 2) => return Err(bad(v, format!("is a {} matrix; channels must be vectors", shape(&v.dims)))),
-            _ => return Err(bad(v, format!("is a {} array; channels must be vectors", shape(&v.dims)))),
-        };
-        if let Some(i) = values.iter().position(|x| !x.is_finite()) {
-            return Err(RecordingError::MatNonFinite {
-                path: p(),
-                variable: v.name.clone(),
-                sample: i as u64 + 1,
-                value: values[i],
-            });
-        }
-        if scalar {
-            constants.push((v.name.clone(), values[0]));
-            continue;
-        }
-        if let Some(first) = columns.first().filter(|c| c.values.len() != values.len()) {
-            return Err(RecordingError::MatLength {
-                path: p(),
-                variable: v.name.clone(),
-                len: values.len(),
-                first: first.name.clone(),
-                first_len: first.values.len(),
-            });
-        }
-        columns.push(Column { name: v.name.clone(), values: values.clone() });
-    }
-    let rows = columns.first().map_or(0, |c| c.values.len());
-    if rows == 0 {
-        return Err(RecordingError::MatFormat { path: p(), reason: "holds no vector variable (no channel)".into() });
-    }
-    if rows < 3 {
-        return Err(RecordingError::TooShort { path: p(), rows });
-    }
-    Ok(Recording { path: p(), columns, constants, lines: (1..=rows as u64).collect(), format: Format::Mat })
+    })
 }

@@ -6,7 +6,13 @@
 //! Every rejection is a [`RecordingError`] naming the file, the line (CSV) or the sample
 //! (MAT) and the reason; nothing is silently dropped.
 
+pub mod dialect;
+mod dspace;
 mod mat;
+mod select;
+mod text;
+pub use select::Channels;
+mod variables;
 
 use std::path::{Path, PathBuf};
 
@@ -21,14 +27,19 @@ pub enum RecordingError {
     Empty { path: PathBuf },
     #[error("{path}:{line}: {reason}")]
     Malformed { path: PathBuf, line: u64, reason: String },
-    #[error("{path}:{line}: column `{column}`: `{text}` is not a number")]
-    NotANumber { path: PathBuf, line: u64, column: String, text: String },
+    #[error("{path}:{line}: column `{column}`: `{text}` is not a number{hint}")]
+    NotANumber { path: PathBuf, line: u64, column: String, text: String, hint: String },
     #[error("{path}:{line}: column `{column}`: value is {text} (NaN/Inf are not accepted)")]
     NonFinite { path: PathBuf, line: u64, column: String, text: String },
     #[error("{path}:{line}: column `{column}` has no value")]
     MissingValue { path: PathBuf, line: u64, column: String },
     #[error("{path}: no column `{name}` (columns: {available})")]
     MissingColumn { path: PathBuf, name: String, available: String },
+    /// A channel the file holds but that cannot be one (skipped when the file was read).
+    #[error("{path}: {detail}")]
+    Unusable { path: PathBuf, detail: String },
+    #[error("{path}: `{name}` is given as a constant but the recording has a channel `{name}`")]
+    SetShadows { path: PathBuf, name: String },
     #[error("{path}:{line}: time {t} s does not increase (previous row {prev} s)")]
     TimeNotIncreasing { path: PathBuf, line: u64, prev: f64, t: f64 },
     #[error("{path}: only {rows} data row(s); at least 3 are needed")]
@@ -69,23 +80,6 @@ pub struct Column {
     pub values: Vec<f64>,
 }
 
-/// Which columns play which role.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Channels {
-    pub time: String,
-    pub input: String,
-    pub output: String,
-    /// Channel driving current/voltage-dependent parameters, if any.
-    pub command: Option<String>,
-}
-
-impl Default for Channels {
-    /// The contract's defaults for an MR clutch: `t`, `b`, `torque`.
-    fn default() -> Self {
-        Self { time: "t".into(), input: "b".into(), output: "torque".into(), command: None }
-    }
-}
-
 /// A recording: equally long numeric columns, plus single values given only on the
 /// first row (e.g. the Dyke files' sampling frequency `fs`).
 #[derive(Clone, Debug, PartialEq)]
@@ -98,10 +92,17 @@ pub struct Recording {
     pub lines: Vec<u64>,
     /// CSV or MAT: whether `lines` are file lines or sample numbers.
     pub format: Format,
+    /// Variables of the file that are not channels (a matrix, text, another length, NaN),
+    /// with the reason; an error only when a command asks for one of them.
+    pub skipped: Vec<Skipped>,
 }
 
-fn parse_number(text: &str) -> Result<f64, ()> {
-    text.parse::<f64>().map_err(|_| ())
+/// A variable of the file that is not a channel, and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Skipped {
+    pub name: String,
+    /// The whole reason, e.g. ``variable `x_F` is a 1501×3 matrix; …``.
+    pub reason: String,
 }
 
 /// A field as shown in a message: at most 40 characters, control characters escaped.
@@ -141,14 +142,21 @@ impl Recording {
     /// Parse level-5 MAT-file bytes: one numeric vector per channel (all the same
     /// length), a scalar variable becomes a constant; `path` is used in messages only.
     pub fn parse_mat(path: &Path, bytes: &[u8]) -> Result<Self, RecordingError> {
-        mat::parse(path, bytes)
+        variables::recording(path, mat::read(path, bytes)?)
     }
 
     /// A recording made in memory (synthetic signals, tests): `columns` must be equally
     /// long; positions in messages are sample numbers.
     pub fn from_columns(path: &Path, columns: Vec<Column>, constants: Vec<(String, f64)>) -> Self {
         let rows = columns.first().map_or(0, |c| c.values.len());
-        Self { path: path.to_path_buf(), columns, constants, lines: (1..=rows as u64).collect(), format: Format::Mat }
+        Self {
+            path: path.to_path_buf(),
+            columns,
+            constants,
+            lines: (1..=rows as u64).collect(),
+            format: Format::Mat,
+            skipped: Vec::new(),
+        }
     }
 
     /// Where samples `first..=last` (0-based) are, for messages: `rec.csv:12-40` (file
@@ -209,107 +217,10 @@ impl Recording {
         Self::parse_csv(path, &bytes)
     }
 
-    /// Parse CSV bytes; `path` is used in messages only.
+    /// Parse text bytes (CSV, or semicolon-, tab- or space-separated, see [`dialect`]);
+    /// `path` is used in messages only.
     pub fn parse_csv(path: &Path, bytes: &[u8]) -> Result<Self, RecordingError> {
-        let p = || path.to_path_buf();
-        if bytes.iter().all(|b| b.is_ascii_whitespace()) {
-            return Err(RecordingError::Empty { path: p() });
-        }
-        if let Some(offset) = bytes.iter().position(|&b| b == 0) {
-            return Err(RecordingError::Binary { path: p(), offset });
-        }
-        let mut rdr =
-            csv::ReaderBuilder::new().has_headers(true).flexible(true).trim(csv::Trim::All).from_reader(bytes);
-        let header =
-            rdr.headers().map_err(|e| RecordingError::Malformed { path: p(), line: 1, reason: e.to_string() })?.clone();
-        // A trailing comma gives a last, unnamed column: ignore unnamed columns that stay empty.
-        let names: Vec<String> = header.iter().map(str::to_owned).collect();
-        if names.iter().all(String::is_empty) {
-            return Err(RecordingError::Malformed {
-                path: p(),
-                line: 1,
-                reason: "the header row has no column names".into(),
-            });
-        }
-        let mut seen = std::collections::HashSet::with_capacity(names.len());
-        for n in &names {
-            if !n.is_empty() && !seen.insert(n.as_str()) {
-                return Err(RecordingError::Malformed {
-                    path: p(),
-                    line: 1,
-                    reason: format!("column `{}` appears twice in the header", shown(n)),
-                });
-            }
-        }
-        let width = names.len();
-        let mut raw: Vec<Vec<Option<f64>>> = vec![Vec::new(); width];
-        let mut lines = Vec::new();
-        for rec in rdr.records() {
-            let rec = rec.map_err(|e| RecordingError::Malformed {
-                path: p(),
-                line: e.position().map_or(0, |pos| pos.line()),
-                reason: e.to_string(),
-            })?;
-            let line = rec.position().map_or(0, |pos| pos.line());
-            if rec.iter().all(str::is_empty) {
-                continue; // blank line
-            }
-            if rec.len() > width && rec.iter().skip(width).any(|f| !f.is_empty()) {
-                return Err(RecordingError::Malformed {
-                    path: p(),
-                    line,
-                    reason: format!("{} fields but the header names {width}", rec.len()),
-                });
-            }
-            for (i, col) in raw.iter_mut().enumerate() {
-                let text = rec.get(i).unwrap_or("");
-                // The column's name is only looked at (and copied) for an error message.
-                let name = || names.get(i).map_or_else(String::new, |n| shown(n));
-                if text.is_empty() {
-                    col.push(None);
-                    continue;
-                }
-                let v = parse_number(text).map_err(|_| RecordingError::NotANumber {
-                    path: p(),
-                    line,
-                    column: name(),
-                    text: shown(text),
-                })?;
-                if !v.is_finite() {
-                    return Err(RecordingError::NonFinite { path: p(), line, column: name(), text: shown(text) });
-                }
-                col.push(Some(v));
-            }
-            lines.push(line);
-        }
-        let rows = lines.len();
-        if rows == 0 {
-            return Err(RecordingError::HeaderOnly { path: p() });
-        }
-        let mut columns = Vec::new();
-        let mut constants = Vec::new();
-        for (name, col) in names.into_iter().zip(raw) {
-            let filled = col.iter().filter(|v| v.is_some()).count();
-            if filled == 0 && name.is_empty() {
-                continue; // trailing comma
-            }
-            if filled == 1 && rows > 1 && col.first().is_some_and(Option::is_some) {
-                constants.push((name, col.first().copied().flatten().unwrap_or(f64::NAN)));
-                continue;
-            }
-            if let Some(missing) = col.iter().position(Option::is_none) {
-                return Err(RecordingError::MissingValue {
-                    path: p(),
-                    line: lines.get(missing).copied().unwrap_or(0),
-                    column: if name.is_empty() { format!("#{}", columns.len() + 1) } else { shown(&name) },
-                });
-            }
-            columns.push(Column { name, values: col.into_iter().flatten().collect() });
-        }
-        if rows < 3 {
-            return Err(RecordingError::TooShort { path: p(), rows });
-        }
-        Ok(Self { path: path.to_path_buf(), columns, constants, lines, format: Format::Csv })
+        text::parse(path, bytes)
     }
 
     /// Number of samples.
@@ -326,15 +237,20 @@ impl Recording {
         self.columns.iter().map(|c| c.name.as_str()).collect()
     }
 
-    /// A column by name.
+    /// A column by name (`NAME:K` for column K of a matrix variable). A variable the file
+    /// holds but that is not a channel gives the reason it was skipped.
     pub fn channel(&self, name: &str) -> Result<&[f64], RecordingError> {
-        self.columns.iter().find(|c| c.name == name).map(|c| c.values.as_slice()).ok_or_else(|| {
-            RecordingError::MissingColumn {
-                path: self.path.clone(),
-                name: name.to_owned(),
-                available: self.names().iter().map(|n| shown(n)).collect::<Vec<_>>().join(", "),
-            }
-        })
+        if let Some(c) = self.columns.iter().find(|c| c.name == name) {
+            return Ok(c.values.as_slice());
+        }
+        if let Some(s) = self.skipped.iter().find(|s| s.name == name) {
+            return Err(RecordingError::Unusable { path: self.path.clone(), detail: s.reason.clone() });
+        }
+        let mut available = self.names().iter().map(|n| shown(n)).collect::<Vec<_>>().join(", ");
+        if self.format == Format::Csv && self.names().iter().enumerate().all(|(i, n)| *n == (i + 1).to_string()) {
+            available += "; the file has no header row, so its columns are numbered from 1";
+        }
+        Err(RecordingError::MissingColumn { path: self.path.clone(), name: name.to_owned(), available })
     }
 
     /// The channels `ch` names, checked to be different columns (an output that is also
@@ -378,159 +294,4 @@ impl Recording {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn parse(s: &str) -> Result<Recording, RecordingError> {
-        Recording::parse_csv(Path::new("rec.csv"), s.as_bytes())
-    }
-
-    #[test]
-    fn written_csv_reads_back_the_same_values() {
-        let col = |name: &str, values: Vec<f64>| Column { name: name.into(), values };
-        let columns = vec![col("t", vec![0.0, 0.0005, 0.001]), col("b", vec![0.1 + 0.2, -1e-7, 12345.678901])];
-        let rec = Recording::from_columns(Path::new("mem"), columns, vec![("fs".into(), 2000.0)]);
-        let mut out = Vec::new();
-        rec.write_csv(&mut out).unwrap();
-        let text = String::from_utf8(out).unwrap();
-        assert!(text.starts_with("t,b,fs\n0,0.30000000000000004,2000\n"), "{text}");
-        let back = parse(&text).unwrap();
-        assert_eq!(back.columns, rec.columns);
-        assert_eq!(back.constants, rec.constants);
-    }
-
-    #[test]
-    fn reads_dyke_quirks() {
-        let r = parse("\"t\",\"D\",\"fs\",\"F\",\n0,1.5,3004.8,10,\n0.1,1.6,,11,\n0.2,1.7,,12,\n").unwrap();
-        assert_eq!(r.names(), vec!["t", "D", "F"]);
-        assert_eq!(r.constants, vec![("fs".to_owned(), 3004.8)]);
-        assert_eq!(r.channel("F").unwrap(), &[10.0, 11.0, 12.0]);
-        assert!((r.mean_dt("t").unwrap() - 0.1).abs() < 1e-12);
-    }
-
-    #[test]
-    fn errors_name_line_and_reason() {
-        let msg = |s: &str| parse(s).unwrap_err().to_string();
-        assert!(msg("").contains("empty"));
-        assert!(msg("t,x\n").contains("empty"));
-        let m = msg("t,x\n0,1\n0.1,abc\n0.2,3\n");
-        assert!(m.contains("rec.csv:3") && m.contains("`abc` is not a number"), "{m}");
-        let m = msg("t,x\n0,1\n0.1,NaN\n0.2,3\n");
-        assert!(m.contains("rec.csv:3") && m.contains("NaN"), "{m}");
-        let m = msg("t,x\n0,1\n0.1,\n0.2,3\n");
-        assert!(m.contains("rec.csv:3") && m.contains("no value"), "{m}");
-        let r = parse("t,x\n0,1\n0.1,2\n0.1,3\n").unwrap();
-        let m = r.time("t").unwrap_err().to_string();
-        assert!(m.contains("rec.csv:4") && m.contains("does not increase"), "{m}");
-        let m = r.channel("F").unwrap_err().to_string();
-        assert!(m.contains("no column `F`") && m.contains("t, x"), "{m}");
-    }
-
-    #[test]
-    fn reads_the_real_dyke_file() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/dyke/ranran_50.csv");
-        let r = Recording::read_csv(&path).unwrap();
-        assert_eq!(r.len(), 74_068);
-        assert_eq!(r.names(), vec!["t", "A", "D", "Y", "V", "F"]);
-        assert!(r.time("t").is_ok());
-        let fs = r.constants.iter().find(|(n, _)| n == "fs").map(|c| c.1).unwrap();
-        assert!((1.0 / r.mean_dt("t").unwrap() - fs).abs() < 1.0);
-    }
-
-    fn corpus(name: &str) -> PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/corpus").join(name)
-    }
-
-    #[test]
-    fn reads_mat_files_plain_and_compressed() {
-        let a = Recording::read(&corpus("good.mat")).unwrap();
-        let b = Recording::read(&corpus("good_compressed.mat")).unwrap();
-        assert_eq!(a.format, Format::Mat);
-        assert_eq!(a.names(), vec!["t", "b", "torque", "speed", "temperature"]);
-        assert_eq!(a.constants, vec![("fs".to_owned(), 1000.0)]);
-        assert_eq!(a.len(), 50);
-        assert_eq!(a.columns, b.columns);
-        assert!((a.mean_dt("t").unwrap() - 0.001).abs() < 1e-12);
-        assert_eq!(a.channel("temperature").unwrap()[3], 23.0);
-        assert!((a.channel("speed").unwrap()[49] - 10.0).abs() < 1e-6);
-        let ch = Channels::default();
-        assert_eq!(a.auxiliary(&ch), vec!["speed", "temperature"]);
-        assert_eq!(a.place(0, 2), format!("{}: samples 1-3", corpus("good.mat").display()));
-    }
-
-    #[test]
-    fn mat_errors_name_file_variable_and_sample() {
-        let msg = |n: &str| Recording::read(&corpus(n)).unwrap_err().to_string();
-        let m = msg("truncated.mat");
-        assert!(m.contains("truncated.mat") && m.contains("truncated MAT-file"), "{m}");
-        let m = msg("matrix_shape.mat");
-        assert!(m.contains("variable `torque` is a 3×4 matrix"), "{m}");
-        let m = msg("length_mismatch.mat");
-        assert!(m.contains("variable `torque` has 40 samples but `t` has 50"), "{m}");
-        let m = msg("nan.mat");
-        assert!(m.contains("variable `torque`, sample 17: value is NaN"), "{m}");
-        let m = msg("char_variable.mat");
-        assert!(m.contains("variable `notes` is a char array"), "{m}");
-        let m = msg("garbage.bin");
-        assert!(m.contains("garbage.bin") && m.contains("binary data"), "{m}");
-        let r = Recording::read(&corpus("time_not_increasing.mat")).unwrap();
-        let m = r.time("t").unwrap_err().to_string();
-        assert!(m.contains("time_not_increasing.mat: sample 31: time"), "{m}");
-        // A `.mat` name with text inside is judged as a MAT-file.
-        let m = Recording::parse(Path::new("x.mat"), b"t,b\n0,1\n").unwrap_err().to_string();
-        assert!(m.contains("x.mat") && m.contains("shorter than the 128-byte"), "{m}");
-        // Big-endian files are read too: the plain file with every field byte-swapped.
-        let le = std::fs::read(corpus("good.mat")).unwrap();
-        let be = to_big_endian(&le);
-        let r = Recording::parse(Path::new("be.mat"), &be).unwrap();
-        assert_eq!(r.columns, Recording::parse(Path::new("le.mat"), &le).unwrap().columns);
-    }
-
-    /// Byte-swap an uncompressed little-endian level-5 file (tags, flags, dims and data).
-    fn to_big_endian(le: &[u8]) -> Vec<u8> {
-        fn width(t: u32) -> usize {
-            match t {
-                3 | 4 => 2,
-                5..=7 => 4,
-                9 | 12 | 13 => 8,
-                _ => 1,
-            }
-        }
-        fn elements(src: &[u8], out: &mut Vec<u8>) {
-            let mut pos = 0;
-            while pos + 8 <= src.len() {
-                let first = u32::from_le_bytes(src[pos..pos + 4].try_into().unwrap());
-                let (t, n, head, data_at) = if first >> 16 != 0 {
-                    (first & 0xFFFF, (first >> 16) as usize, 4, pos + 4)
-                } else {
-                    (first, u32::from_le_bytes(src[pos + 4..pos + 8].try_into().unwrap()) as usize, 8, pos + 8)
-                };
-                if head == 4 {
-                    out.extend_from_slice(&((n as u32) << 16 | t).to_be_bytes());
-                } else {
-                    out.extend_from_slice(&t.to_be_bytes());
-                    out.extend_from_slice(&(n as u32).to_be_bytes());
-                }
-                let data = &src[data_at..data_at + n];
-                if t == 14 {
-                    elements(data, out);
-                } else {
-                    let w = width(t);
-                    for c in data.chunks(w) {
-                        out.extend(c.iter().rev());
-                    }
-                }
-                let padded = if head == 4 { 4 } else { n.div_ceil(8) * 8 };
-                out.extend(std::iter::repeat_n(0u8, padded - n));
-                pos = data_at + padded;
-            }
-        }
-        let mut out = le[..128].to_vec();
-        out[124] = 0x01;
-        out[125] = 0x00;
-        out[126] = b'M';
-        out[127] = b'I';
-        elements(&le[128..], &mut out);
-        out
-    }
-}
+mod tests;

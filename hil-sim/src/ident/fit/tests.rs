@@ -1,0 +1,71 @@
+use super::*;
+use crate::models::replay;
+
+/// A recording of `id` with `truth`, whose input channel was logged `lag` samples late.
+fn lagged(id: &str, truth: &[f32], lag: f64, command: bool) -> Dataset {
+    let dt = 1e-3;
+    let n = 6000;
+    let time: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
+    let x_true: Vec<f64> = time
+        .iter()
+        .map(|t| (2.0 * std::f64::consts::PI * 3.0 * t).sin() + 0.4 * (2.0 * std::f64::consts::PI * 11.0 * t).sin())
+        .collect();
+    let u = command.then(|| time.iter().map(|t| 1.0 + 0.8 * (3.1 * t).sin()).collect::<Vec<f64>>());
+    let samples = crate::models::replay::samples(&x_true, u.as_deref());
+    let out = replay(id, truth, dt as f32, RateSpec::Backward, &samples).unwrap();
+    // The logged input is the true one `lag` samples late: x_log(t) = x_true(t − lag).
+    let input = crate::models::alignment::shift(&x_true, -lag);
+    Dataset {
+        dt,
+        time,
+        input,
+        output: out.y.iter().map(|v| f64::from(*v)).collect(),
+        command: u,
+        train_end: 4200,
+        excluded: vec![false; n],
+        unusable: Vec::new(),
+        rates: None,
+        runs: Vec::new(),
+    }
+}
+
+fn opts(delay: DelayChoice) -> FitOptions {
+    // Noiseless data: let Levenberg–Marquardt run to convergence.
+    FitOptions {
+        rate: Some(RateSpec::Backward),
+        delay,
+        lm_iterations: 80,
+        polish_iterations: 80,
+        ..FitOptions::default()
+    }
+}
+
+#[test]
+fn closed_form_fit_finds_a_known_input_delay() {
+    let data = lagged("algebraic", &[2.0, 0.05, -0.3, 0.1], 3.0, false);
+    let auto = fit("algebraic", &data, &opts(DelayChoice::Auto)).unwrap();
+    let off = fit("algebraic", &data, &opts(DelayChoice::Off)).unwrap();
+    assert!((auto.delay_s - 3e-3).abs() < 0.3e-3, "delay {} s", auto.delay_s);
+    assert_eq!(off.delay_s, 0.0);
+    assert!(auto.heldout.rmse < 1e-3 * off.heldout.rmse, "{} vs {}", auto.heldout.rmse, off.heldout.rmse);
+}
+
+#[test]
+fn iterative_fit_finds_a_known_input_delay() {
+    let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
+    let data = lagged("bouc_wen", &truth, -2.5, false);
+    let auto = fit("bouc_wen", &data, &opts(DelayChoice::Auto)).unwrap();
+    let off = fit("bouc_wen", &data, &opts(DelayChoice::Off)).unwrap();
+    assert!(
+        (auto.delay_s + 2.5e-3).abs() < 0.5e-3,
+        "delay {} s, rmse {} vs {}",
+        auto.delay_s,
+        auto.train.rmse,
+        off.train.rmse
+    );
+    assert_eq!(auto.command_delay_s, 0.0, "no command channel, no command delay");
+    assert!(auto.train.rmse < off.train.rmse, "{} vs {}", auto.train.rmse, off.train.rmse);
+    // A given delay is used as given.
+    let fixed = fit("bouc_wen", &data, &opts(DelayChoice::Fixed(-2.5e-3, 0.0))).unwrap();
+    assert!((fixed.delay_s + 2.5e-3).abs() < 1e-12);
+}
