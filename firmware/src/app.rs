@@ -198,7 +198,8 @@ async fn main(spawner: Spawner) {
     // 0 up, repetition counter 1, load it with UG, start ([`board::align_update`]).
     board::align_update(1);
     controller::safe_state();
-    let max_duty = pwm.get_max_duty();
+    // Centre-aligned: a compare of ARR + 1 keeps the output active the whole period.
+    let max_duty = pwm.get_max_duty() + 1;
     if max_duty != board::PWM_COUNTS {
         fatal("TIM1 counts for duty 1 differ from firmware::bringup::PWM_COUNTS");
     }

@@ -9,7 +9,8 @@ use model_core::Model;
 pub const CONTROL_HZ: u32 = 20_000;
 /// Core and timer clock, Hz.
 pub const CORE_HZ: u32 = 170_000_000;
-/// TIM1 counts for duty 1: centre-aligned, so half a period of core clocks.
+/// TIM1 counts for duty 1: centre-aligned, so half a period of core clocks (ARR + 1: a
+/// compare of ARR + 1 keeps the output active through the whole period).
 pub const PWM_COUNTS: u32 = CORE_HZ / CONTROL_HZ / 2;
 /// ADC (and DAC) reference voltage, V, and full scale, counts.
 pub const VREF: f32 = 3.3;
