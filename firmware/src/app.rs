@@ -84,6 +84,22 @@ fn page_error(e: &model_core::control::PageError) -> &'static str {
     }
 }
 
+/// Which configuration runs, for telemetry and the firmware-in-the-loop test:
+/// `seq << 2 | slot` with slot 1 = A, 2 = B; 0 = compiled-in defaults on a blank board,
+/// 3 = defaults because the slots are damaged. `#[used]`: kept (and its stores with it)
+/// for the debugger and the emulator, which read it by symbol.
+#[used]
+pub static CONFIG_SOURCE: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
+
+fn source_code(running: Option<(Slot, u32)>, damaged: bool) -> u32 {
+    match running {
+        Some((Slot::A, seq)) => seq << 2 | 1,
+        Some((Slot::B, seq)) => seq << 2 | 2,
+        None if damaged => 3,
+        None => 0,
+    }
+}
+
 /// What one slot holds.
 fn inspect(slot: Slot) -> (SlotState, Option<(Loop, ValidatedConfig)>) {
     let Ok(bytes) = flash::read_slot(slot) else {
@@ -165,6 +181,7 @@ async fn main(spawner: Spawner) {
     cp.DWT.enable_cycle_counter();
 
     let loaded = load_config();
+    CONFIG_SOURCE.store(source_code(loaded.running, loaded.damaged), Ordering::Relaxed);
     let _flash_owner = b.flash;
 
     // Bridge: centre-aligned PWM at CONTROL_HZ, complementary outputs with dead time,
@@ -469,6 +486,7 @@ async fn commit(page: &mut PageAssembler, crc: u32, running: Option<(Slot, u32)>
     critical_section::with(|cs| controller::PENDING.borrow_ref_mut(cs).replace((lp, cfg)));
     // A damaged board runs again once a good page is committed.
     controller::RESET.store(true, Ordering::Relaxed);
+    CONFIG_SOURCE.store(source_code(Some((slot, seq)), false), Ordering::Relaxed);
     info!("new configuration: model {}, slot {} commit {}", img.model_id(), slot, seq);
     Ok((slot, seq))
 }

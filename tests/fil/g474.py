@@ -565,7 +565,7 @@ class Machine:
         if size < 4:
             sh = (addr & 3) * 8
             mask = ((1 << (8 * size)) - 1) << sh
-            val = (p.regs.get(o, 0) & ~mask) | ((val << sh) & mask)
+            val = (p.read(self, o) & ~mask) | ((val << sh) & mask)
         p.write(self, o, val)
 
     def _unmapped(self, uc, access, addr, size, value, ud):

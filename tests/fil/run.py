@@ -1,13 +1,16 @@
 """Firmware in the loop: run the shipping ELF on the emulated G474 (g474.py).
 
-    run.py ELF control SAMPLES.csv TRACE.csv   boot, enable over CAN, one sample per PWM
-                                               period from SAMPLES (hall,current,supply,
-                                               reference); per period the trace holds what
-                                               the control interrupt saw and wrote
+    run.py ELF control PERIODS TRACE.csv       from reset, closed loop on a coil model,
+                                               enable and set-points over CAN; per period
+                                               the trace holds what the control interrupt
+                                               saw and wrote (compared with model-core on
+                                               the host by tests/tests/firmware_in_loop.rs)
     run.py ELF faults                          panic, HardFault, NMI, stuck interrupt,
                                                watchdog stall: MOE off in time
-    run.py ELF powercut PAGE.bin               a configuration commit cut at every flash
-                                               operation: boots on the old or new page
+    run.py ELF powercut FLASH.bin PAGE.bin     FLASH.bin (both slots, A holding an old page)
+                                               as the flash; PAGE.bin committed over CAN
+                                               and cut at every flash operation: boots
+                                               on the old or the new page
 
 Prints one line per check and `N passed, M failed`; exit 1 on a failure.
 """
@@ -45,35 +48,79 @@ def send(m, data, periods=4):
         m.period(QUIET)
 
 
-def control(elf, samples_csv, trace_csv):
+class Plant:
+    """The coil and the Hall sensor, enough to keep the loop's plausibility checks quiet:
+    i' = (V − R·i)/L with V = duty · supply, B = 0.2 T/A · i, 12-bit readings with the
+    default configuration's scales and a small deterministic noise (a frozen Hall reading
+    would trip the stuck-sensor check)."""
+
+    R, L, DT = 4.0, 0.05, 1.0 / 20_000
+
+    def __init__(self):
+        self.i, self.seed = 0.0, 12345
+
+    def noise(self):
+        self.seed = (self.seed * 1103515245 + 12345) & 0x7FFF_FFFF
+        return (self.seed >> 16) % 5 - 2
+
+    def sample(self, supply_counts):
+        b = 0.2 * self.i
+        hall = int(round(2048 + b / (1.25 / 2048))) + self.noise()
+        cur = int(round(2048 + self.i / (6.0 / 2048))) + self.noise()
+        clamp = lambda x: max(0, min(4095, x))
+        return clamp(hall), clamp(cur), supply_counts
+
+    def advance(self, ccr1, ccr2, moe, supply_v):
+        v = (ccr1 - ccr2) / 4250.0 * supply_v if moe else 0.0
+        self.i += self.DT * (v - self.R * self.i) / self.L
+
+
+def reference(k):
+    """Torque reference (N·m): off, a step, a slow sine."""
+    import math
+    if k < 2000:
+        return 0.0
+    if k < 8000:
+        return 1.5
+    return 1.0 + 0.8 * math.sin(2 * math.pi * 5 * k / 20_000)
+
+
+def control(elf, periods, trace_csv):
+    """Closed loop from reset: every period's inputs and what the interrupt wrote."""
     m = g474.Machine(elf)
-    boot(m)
-    send(m, bytes([0x02, 1]))
+    plant = Plant()
     addr = {k: sym(m, p) for k, p in [("en", "controller6ENABLE"), ("ref", "controller9REFERENCE"),
                                        ("reset", "controller5RESET"), ("stall", "controller7STALLED"),
                                        ("slow", "controller11SLOW_PASSES"), ("n", "controller7SAMPLES")]}
-    rows = [tuple(float(x) for x in l.split(",")) for l in open(samples_csv).read().split()[1:]]
+    b = lambda a: m.uc.mem_read(a, 1)[0]
     out = open(trace_csv, "w")
-    out.write("hall,current,supply,enable,reference_bits,reset,stalled,slow,ccr1,ccr2,moe\n")
-    last_ref = None
-    for k, (h, i, s, r) in enumerate(rows):
-        bits = struct.unpack("<I", struct.pack("<f", r))[0]
-        if bits != last_ref and k % 20 == 0:
-            # Stream the set-point at 1 kHz (the command timeout is 100 ms).
-            m.can.receive(m, 0x120, bytes([0x01]) + struct.pack("<f", r))
-            last_ref = bits
-        b = lambda a: m.uc.mem_read(a, 1)[0]
+    out.write("ran,hall,current,supply,enable,reference_bits,reset,stalled,slow,ccr1,ccr2,moe\n")
+    supply = 2200
+    supply_v = supply * (3.3 / 4095 * 11)
+    driven = 0
+    for k in range(periods):
+        if k == 100:
+            m.can.receive(m, 0x120, bytes([0x02, 1]))
+        elif k > 100 and k % 20 == 0:
+            # The set-point streamed at 1 kHz (the command timeout is 100 ms).
+            m.can.receive(m, 0x120, bytes([0x01]) + struct.pack("<f", reference(k)))
+        h, i, s = plant.sample(supply)
         seen = (b(addr["en"]), m.read_u32(addr["ref"]), b(addr["reset"]), b(addr["stall"]))
         slow0, n0 = m.read_u32(addr["slow"]), m.read_u32(addr["n"])
-        m.period((int(h), int(i), int(s)))
-        n1 = m.read_u32(addr["n"])
-        if n1 != n0 + 1:
-            raise AssertionError("period %d: %d control steps instead of 1" % (k, n1 - n0))
+        m.period((h, i, s))
+        ran = m.read_u32(addr["n"]) - n0
+        if ran > 1 or (ran == 0 and n0 > 0):
+            raise AssertionError("period %d: %d control steps instead of 1" % (k, ran))
         slow = m.read_u32(addr["slow"]) - slow0
         c1, c2 = m.compares()
-        out.write("%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d\n" % (h, i, s, *seen, slow, c1, c2, int(m.tim1.moe)))
+        moe = m.tim1.moe
+        driven += moe
+        plant.advance(c1, c2, moe, supply_v)
+        out.write("%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d\n" % (ran, h, i, s, *seen, slow, c1, c2, int(moe)))
     out.close()
-    print("control: %d periods traced (%.2f s of control at 20 kHz)" % (len(rows), len(rows) / 20000))
+    if m.can.sent[:1] != [(0x121, bytes([0x82, 0x02]))]:
+        raise AssertionError("no ack of the enable command: %r" % m.can.sent[:3])
+    print("control: %d periods traced from reset (%.2f s at 20 kHz), bridge driving in %d" % (periods, periods / 20000, driven))
 
 
 def running(m, periods=200):
@@ -114,11 +161,11 @@ def faults(elf):
     def panic(m):
         # The control interrupt returns into core::panicking::panic (as if its code had
         # panicked): the firmware's panic handler must turn the bridge off.
-        p = sym(m, "9panicking5panic17")
+        p = sym(m, "panicking18panic_bounds_check")
         m.pend(g474.IRQ_ADC1_2)  # make sure we are inside the ISR
         m.uc.reg_write(g474.A.UC_ARM_REG_R0, 0x0800_0000)
         m.uc.reg_write(g474.A.UC_ARM_REG_R1, 4)
-        m.uc.reg_write(g474.A.UC_ARM_REG_R2, 0x0800_0000)
+        m.uc.reg_write(g474.A.UC_ARM_REG_R2, 0x2000_0000)
         m.uc.reg_write(g474.A.UC_ARM_REG_PC, p | 1)
         m.idle = False
 
@@ -131,6 +178,7 @@ def faults(elf):
     m = fresh()
     isr = m.read_u32(0x0800_0000 + 4 * (16 + g474.IRQ_ADC1_2)) & ~1
     m.uc.mem_write(isr, b"\xfe\xe7")
+    m.uc.ctl_remove_cache(isr, isr + 2)  # drop the translated block
     t0 = m.now
     for _ in range(2):
         m.period((2048, 2048, 2200))
@@ -162,61 +210,76 @@ def faults(elf):
 def commit_frames(page):
     frames = [bytes([0x10]) + struct.pack("<H", len(page))]
     for off in range(0, len(page), 5):
-        chunk = page[off:off + 5]
-        frames.append(bytes([0x11]) + struct.pack("<H", off) + chunk)
+        frames.append(bytes([0x11]) + struct.pack("<H", off) + page[off:off + 5])
     frames.append(bytes([0x12]) + struct.pack("<I", zlib.crc32(page) & 0xFFFF_FFFF))
     return frames
 
 
-def loaded_slot(m):
-    """Which page the booted firmware runs: read the commit task's view is not exported,
-    so compare the configuration in RAM with the two pages' control words."""
-    return None
+def source(m):
+    """The configuration the firmware runs (app::CONFIG_SOURCE): (slot, seq)."""
+    v = m.read_u32(sym(m, "app13CONFIG_SOURCE"))
+    return ({0: "defaults", 1: "A", 2: "B", 3: "damaged"}[v & 3], v >> 2)
 
 
-def powercut(elf, page_path):
-    page = open(page_path, "rb").read()
-    page = page[:page.rfind(b"\xff" * 64)] if b"\xff" * 64 in page else page
-    # The reference commit (no cut): count its flash operations.
-    m = g474.Machine(elf)
-    boot(m)
-    before = m.flash.ops
-    replies = m.can.sent
+def commit(m, page, cut_at=None):
+    """Send a page over CAN and wait for the commit's reply (or the cut's reset)."""
+    m.flash.cut_at = cut_at
+    m.can.sent.clear()
     for f in commit_frames(page):
         send(m, f, periods=1)
-    for _ in range(3000):
+    for _ in range(4000):
         m.period(QUIET)
-        if any(d[:1] == b"\x82" and d[1] == 0x12 for _, d in replies):
-            break
+        if any(d[:1] in (b"\x82", b"\x83") and d[1] == 0x12 for _, d in m.can.sent):
+            return m.can.sent[-1][1]
+    raise AssertionError("no reply to the commit")
+
+
+def reboot(m, csr):
+    m.flash.cut_at = None
+    m.boot(csr, keep_flash=bytes(m.flash.array))
+    boot(m, 120)
+
+
+def powercut(elf, flash_path, page_path):
+    """Slot A holds the old page (commit 1); the new page goes to B (commit 2). A reset
+    at every flash operation of the commit must boot A/1 or B/2, never the defaults."""
+    flash = open(flash_path, "rb").read()
+    page = open(page_path, "rb").read()
+    m = g474.Machine(elf, flash_image=flash)
+    boot(m)
+    old = source(m)
+    assert old == ("A", 1), "the old page did not boot: %r" % (old,)
+    before = m.flash.ops
+    reply = commit(m, page)
+    assert reply == bytes([0x82, 0x12]), "commit refused: %r" % reply
     ops = m.flash.ops - before
-    if not ops:
-        raise AssertionError("commit did not program the flash: replies %r" % replies[-3:])
-    new_image = bytes(m.flash.array)
-    print("commit: %d flash operations (erase + double-words)" % ops)
-    good = 0
+    reboot(m, 0x0C00_0000)
+    new = source(m)
+    assert new == ("B", 2), "the new page did not boot: %r" % (new,)
+    print("commit: %d flash operations (page erase + double-words, record last); old %r, new %r" % (ops, old, new))
+    good, seen = 0, {}
     for cut in range(1, ops + 1):
-        m = g474.Machine(elf)
+        m = g474.Machine(elf, flash_image=flash)
         boot(m)
-        old_image = bytes(m.flash.array)
-        m.flash.cut_at = m.flash.ops + cut
         try:
-            for f in commit_frames(page):
-                send(m, f, periods=1)
-            for _ in range(3000):
-                m.period(QUIET)
-            raise AssertionError("cut %d never happened" % cut)
+            commit(m, page, cut_at=m.flash.ops + cut)
+            print("cut %d: the commit finished without reaching it" % cut)
+            continue
         except g474.Reset:
             pass
-        m.flash.cut_at = None
-        m.boot(0x0C00_0000, keep_flash=bytes(m.flash.array))
         try:
-            boot(m, 120)
-            ok = m.read_u32(sym(m, "controller7SAMPLES")) > 0
-        except (g474.Unmodelled, AssertionError) as e:
+            reboot(m, 0x0C00_0000)
+            got = source(m)
+        except (g474.Unmodelled, g474.Reset, AssertionError) as e:
             print("cut %d: not bootable: %s" % (cut, e))
-            ok = False
-        good += ok
-    print("power cut: %d of %d interrupted commits leave a bootable board" % (good, ops))
+            continue
+        if got in (old, new):
+            good += 1
+            seen[got] = seen.get(got, 0) + 1
+        else:
+            print("cut %d: boots %r" % (cut, got))
+    print("power cut: %d of %d interrupted commits boot the old or the new page (%s)"
+          % (good, ops, ", ".join("%s/%d: %d" % (k[0], k[1], v) for k, v in sorted(seen.items()))))
     return [good == ops]
 
 
@@ -224,9 +287,9 @@ def main():
     g474.Machine.objdump = os.environ.get("OBJDUMP", "llvm-objdump")
     elf, what = sys.argv[1], sys.argv[2]
     if what == "control":
-        control(elf, sys.argv[3], sys.argv[4])
+        control(elf, int(sys.argv[3]), sys.argv[4])
         return
-    res = faults(elf) if what == "faults" else powercut(elf, sys.argv[3])
+    res = faults(elf) if what == "faults" else powercut(elf, sys.argv[3], sys.argv[4])
     p = sum(res)
     print("%d passed, %d failed" % (p, len(res) - p))
     sys.exit(0 if p == len(res) else 1)
