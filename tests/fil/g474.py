@@ -572,9 +572,16 @@ class Machine:
         self.fault = "unmapped access 0x%08x at pc 0x%08x" % (addr, uc.reg_read(A.UC_ARM_REG_PC))
         return False
 
+    ecc_latched = None
+
     def _slot_rd(self, uc, off, size, ud):
+        # An uncorrectable double-word raises the NMI once: the stop below makes Unicorn
+        # re-execute the load after the handler returns, which must then just read.
         a = off & ~7
-        if SLOT_A + a in self.flash.ecc_bad:
+        if SLOT_A + a != self.ecc_latched:
+            self.ecc_latched = None
+        if SLOT_A + a in self.flash.ecc_bad and self.ecc_latched is None:
+            self.ecc_latched = SLOT_A + a
             self.flash.regs[0x18] = (self.flash.regs.get(0x18, 0) | (1 << 31)) & ~0x7FFFF | ((SLOT_A + a) & 0x7FFFF)
             self.pend_nmi = True
             uc.emu_stop()
