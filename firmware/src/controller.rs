@@ -205,10 +205,17 @@ fn TIM1_UP_TIM16() {
 /// The control interrupt has run at least once (the monitor starts then).
 pub static RUNNING: AtomicBool = AtomicBool::new(false);
 
+/// The control interrupt. It masks nothing (no `cpsid`): the deadline monitor above it
+/// must be able to pre-empt a step that does not finish.
 #[interrupt]
 fn ADC1_2() {
     let t0 = cortex_m::peripheral::DWT::cycle_count();
-    critical_section::with(|cs| {
+    // SAFETY: a critical-section token without masking interrupts. Thread mode touches
+    // CONTROL only before this interrupt is enabled, and PENDING/TELEMETRY only inside
+    // real critical sections (PRIMASK), which this interrupt cannot pre-empt; the only
+    // handler above this one (TIM1_UP_TIM16) touches none of the cells.
+    let cs = unsafe { critical_section::CriticalSection::new() };
+    {
         let mut ctl = CONTROL.borrow_ref_mut(cs);
         let Some(c) = ctl.as_mut() else {
             safe_state();
@@ -253,5 +260,5 @@ fn ADC1_2() {
             c.lp.slow(&c.cfg, f32::NAN);
             SLOW_PASSES.fetch_add(1, Ordering::Relaxed);
         }
-    });
+    }
 }

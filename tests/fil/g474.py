@@ -540,6 +540,7 @@ class Machine:
         import subprocess
         out = subprocess.run([self.objdump, "-d", "--no-show-raw-insn", self.elf_path],
                              capture_output=True, text=True, check=True).stdout
+        self.disassembly = out
         return [int(l.split(":")[0], 16) for l in out.splitlines() if l.strip().endswith("\twfe") or l.rstrip().endswith(" wfe")]
 
     objdump = "llvm-objdump"
@@ -731,6 +732,28 @@ class Machine:
     # -- observation ---------------------------------------------------------------
     def compares(self):
         return self.tim1.regs.get(0x34, 0), self.tim1.regs.get(0x38, 0)
+
+    def returns_in(self, function):
+        """(address, size) of every return (`pop {.., pc}`, `bx lr`) in the function whose
+        llvm-objdump name contains `function`."""
+        inside, lines = False, []
+        for line in self.disassembly.splitlines():
+            if line.endswith(">:") and function in line:
+                inside = True
+            elif inside and line.strip() == "":
+                break
+            elif inside and ":" in line:
+                lines.append(line)
+        out = []
+        for this, nxt in zip(lines, lines[1:] + [None]):
+            ins = this.split("\t", 1)[-1]
+            if ("pop" in ins and "pc" in ins) or ins.startswith("bx\tlr"):
+                a = int(this.split(":")[0], 16)
+                size = int(nxt.split(":")[0], 16) - a if nxt else 2
+                out.append((a, size))
+        if not out:
+            raise Unmodelled("no return in %s" % function)
+        return out
 
     def in_handler(self):
         return [s[0] for s in self.stack]

@@ -145,7 +145,8 @@ def within_period(m, what, inject):
     except g474.Unmodelled:
         pass  # the handler parks the core (UDF/loop): what counts is MOE
     ok = not m.tim1.moe
-    print("%s: MOE %s within %.1f µs" % (what, "off" if ok else "STILL ON", (m.now - t0) / 1000))
+    print("%s: MOE %s by the end of the PWM period it happened in (%.0f µs)"
+          % (what, "off" if ok else "STILL ON", g474.PERIOD_NS / 1000))
     return ok
 
 
@@ -173,19 +174,26 @@ def faults(elf):
     results.append(within_period(fresh(), "HardFault", lambda m: m.pend(g474.EXC_HARDFAULT)))
     results.append(within_period(fresh(), "NMI", lambda m: m.pend(g474.EXC_NMI)))
 
-    # A stuck control interrupt: the ISR entry patched to spin (b .); the deadline monitor
-    # (TIM1 update, above it) must clear MOE within one period.
+    # A stuck control interrupt: every return of its body patched to spin (b .), so it
+    # hangs after writing the compares with MOE on; the deadline monitor (TIM1 update,
+    # above it) must clear MOE within one period.
     m = fresh()
-    isr = m.read_u32(0x0800_0000 + 4 * (16 + g474.IRQ_ADC1_2)) & ~1
-    m.uc.mem_write(isr, b"\xfe\xe7")
-    m.uc.ctl_remove_cache(isr, isr + 2)  # drop the translated block
-    t0 = m.now
-    for _ in range(2):
+    for at, size in m.returns_in("__cortex_m_rt_ADC1_2"):
+        m.uc.mem_write(at, b"\xfe\xe7" + b"\x00\xbf" * ((size - 2) // 2))  # b . ; nop
+        m.uc.ctl_remove_cache(at, at + size)  # drop the translated block
+    n = sym(m, "controller7SAMPLES")
+    missed_at = None  # end of the first period whose step did not run: its deadline
+    for _ in range(4):
+        before = m.read_u32(n)
         m.period((2048, 2048, 2200))
-        if not m.tim1.moe:
+        if missed_at is None and m.read_u32(n) == before:
+            missed_at = m.now
+        if missed_at is not None and not m.tim1.moe:
             break
-    ok = not m.tim1.moe and m.now - t0 <= 2 * g474.PERIOD_NS
-    print("stuck control interrupt: MOE %s after %.1f µs" % ("off" if not m.tim1.moe else "STILL ON", (m.now - t0) / 1000))
+    late = (m.now - missed_at) / 1000 if missed_at is not None else float("inf")
+    ok = not m.tim1.moe and late <= g474.PERIOD_NS / 1000
+    print("stuck control interrupt: MOE %s %.0f µs after the first missed step's deadline"
+          % ("off" if ok else "STILL ON", late))
     results.append(ok)
 
     # Watchdog stall: thread mode stops (time driver interrupts withheld): the IWDG must

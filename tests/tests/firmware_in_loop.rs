@@ -118,7 +118,12 @@ fn one_second_of_control_matches_model_core() {
             overrun: stalled != 0,
             enable: enable != 0 && stalled == 0,
             reset: reset != 0,
-            ..ControlInput::new(hall as u16, current as u16, supply_volts(supply as u16), f32::from_bits(reference as u32))
+            ..ControlInput::new(
+                hall as u16,
+                current as u16,
+                supply_volts(supply as u16),
+                f32::from_bits(reference as u32),
+            )
         };
         let out = step.step(&cfg, &mut st, input);
         let (next, action) = bridge.next(out.pwm_enable);
