@@ -499,7 +499,7 @@ class Machine:
         self.scs = Scs()
         self.rcc = Rcc(csr_flags)
         self.periph = [
-            self.rcc, self.flash, self.tim1, self.tim15, self.adc, self.can, self.iwdg, self.scs,
+            self.rcc, self.flash, self.tim1, self.tim15, self.adc, self.can, self.iwdg,
             window("PWR", 0x4000_7000, 0x400, {0x14: 0}),
             window("GPIOA", 0x4800_0000, 0x400, {0x00: 0xABFF_FFFF}),
             window("GPIOB", 0x4800_0400, 0x400, {0x00: 0xFFFF_FEBF}),
@@ -513,6 +513,7 @@ class Machine:
             window("EXTI", 0x4001_0400, 0x400),
             window("DAC3", 0x5000_1000, 0x400),
             window("DBGMCU", 0xE004_2000, 0x100),
+            self.scs,  # last: the DBGMCU window lies inside its range
         ]
         self.fdcan_ram = (Fdcan.RAM, 0x350 * 3)
         uc.mmio_map(0x4000_0000, 0xA000, self._rd, 0x4000_0000, self._wr, 0x4000_0000)

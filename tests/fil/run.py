@@ -5,6 +5,7 @@
                                                the trace holds what the control interrupt
                                                saw and wrote (compared with model-core on
                                                the host by tests/tests/firmware_in_loop.rs)
+    run.py ELF board                           boot; the bring-up registers as JSON
     run.py ELF faults                          panic, HardFault, NMI, stuck interrupt,
                                                watchdog stall: MOE off in time
     run.py ELF powercut FLASH.bin PAGE.bin     FLASH.bin (both slots, A holding an old page)
@@ -291,9 +292,40 @@ def powercut(elf, flash_path, page_path):
     return [good == ops]
 
 
+def board(elf):
+    """Boot and dump the registers the bring-up set (JSON on the last line); the Rust test
+    checks them against the firmware's own numbers."""
+    import json
+    m = g474.Machine(elf)
+    boot(m)
+    p = {q.name: q for q in m.periph}
+    ram = g474.Fdcan.RAM
+    regs = {
+        "rcc_cr": m.rcc.regs.get(0x00, 0), "rcc_pllcfgr": m.rcc.regs.get(0x0C, 0),
+        "rcc_ccipr": m.rcc.regs.get(0x88, 0), "rcc_cfgr": m.rcc.regs.get(0x08, 0),
+        "tim1_bdtr": m.tim1.regs.get(0x44, 0), "tim1_af1": m.tim1.regs.get(0x60, 0),
+        "tim1_rcr": m.tim1.regs.get(0x30, 0), "tim1_cr2": m.tim1.regs.get(0x04, 0),
+        "tim1_dier": m.tim1.regs.get(0x0C, 0), "tim1_arr": m.tim1.regs.get(0x2C, 0),
+        "comp1_csr": p["COMP"].regs.get(0x00, 0), "dac3_dhr12r1": p["DAC3"].regs.get(0x08, 0),
+        "dac3_cr": p["DAC3"].regs.get(0x00, 0), "dac3_mcr": p["DAC3"].regs.get(0x3C, 0),
+        "syscfg_cfgr2": p["SYSCFG"].regs.get(0x1C, 0), "dbgmcu_apb1fzr1": p["DBGMCU"].regs.get(0x08, 0),
+        "adc1_smpr1": m.adc.regs.get(0x14, 0), "adc1_smpr2": m.adc.regs.get(0x18, 0),
+        "adc1_jsqr": m.adc.regs.get(0x4C, 0), "adc12_ccr": m.adc.regs.get(0x308, 0),
+        "fdcan_nbtp": m.can.regs.get(0x1C, 0), "fdcan_rxgfc": m.can.regs.get(0x80, 0),
+        "fdcan_flssa0": m.read_u32(ram), "iwdg_pr": m.iwdg.regs.get(0x04, 0), "iwdg_rlr": m.iwdg.regs.get(0x08, 0),
+        "rcc_csr": m.rcc.read(m, 0x94),
+        "prio": {str(k): v for k, v in sorted(m.prio.items()) if k in (18, 21, 22, 24, 25)},
+        "enabled": sorted(i for i in m.enabled if i in (18, 21, 22, 24, 25)),
+    }
+    print(json.dumps(regs))
+
+
 def main():
     g474.Machine.objdump = os.environ.get("OBJDUMP", "llvm-objdump")
     elf, what = sys.argv[1], sys.argv[2]
+    if what == "board":
+        board(elf)
+        return
     if what == "control":
         control(elf, int(sys.argv[3]), sys.argv[4])
         return

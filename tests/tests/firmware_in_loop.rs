@@ -179,3 +179,69 @@ fn a_commit_cut_at_every_flash_operation_boots_old_or_new() {
     let out = run(&f, &["powercut", flash_path.to_str().expect("utf-8"), page_path.to_str().expect("utf-8")]);
     assert!(out.contains("1 passed, 0 failed"), "{out}");
 }
+
+/// One field of a register dump: `(value >> shift) & mask`.
+fn field(regs: &serde_json::Value, name: &str, shift: u32, mask: u64) -> u64 {
+    let v = regs[name].as_u64().unwrap_or_else(|| panic!("register {name} missing from the dump"));
+    (v >> shift) & mask
+}
+
+/// The bring-up configuration as the shipping ELF leaves it after boot (RM0440 fields).
+#[test]
+fn bring_up_registers_after_boot() {
+    let Some(f) = fil() else { return };
+    let out = run(&f, &["board"]);
+    let regs: serde_json::Value = serde_json::from_str(out.lines().last().expect("dump")).expect("JSON");
+    let r = |name: &str, shift: u32, mask: u64| field(&regs, name, shift, mask);
+    // Clocks: HSE on, PLL from HSE /6 ×85, P /8 for the ADC, R /2 for SYSCLK.
+    assert_eq!(r("rcc_cr", 16, 1), 1, "HSEON");
+    assert_eq!(r("rcc_pllcfgr", 0, 3), 3, "PLLSRC = HSE");
+    assert_eq!(r("rcc_pllcfgr", 4, 0xF) + 1, 6, "PLLM");
+    assert_eq!(r("rcc_pllcfgr", 8, 0x7F), 85, "PLLN");
+    assert_eq!((r("rcc_pllcfgr", 16, 1), r("rcc_pllcfgr", 27, 0x1F)), (1, 8), "PLLP enabled, /8");
+    assert_eq!(r("rcc_ccipr", 28, 3), 1, "ADC12SEL = PLL P (not disabled)");
+    assert_eq!(r("rcc_ccipr", 24, 3), 0, "FDCANSEL = HSE");
+    // ADC: Hall and current 12.5 cycles, the supply (channel 12) 47.5; TIM1_TRGO2 rising.
+    assert_eq!((r("adc1_smpr1", 3, 7), r("adc1_smpr1", 6, 7)), (2, 2), "SMP1, SMP2 = 12.5 cycles");
+    assert_eq!(r("adc1_smpr2", 6, 7), 4, "SMP12 = 47.5 cycles");
+    assert_eq!((r("adc1_jsqr", 2, 0x1F), r("adc1_jsqr", 7, 3)), (8, 1), "JEXTSEL TIM1_TRGO2, rising");
+    // TIM1: update as TRGO2 once per period, the deadline monitor's interrupt, dead time,
+    // break from COMP1 active high, BDTR locked.
+    assert_eq!(r("tim1_cr2", 20, 0xF), 2, "MMS2 = update");
+    assert_eq!(r("tim1_rcr", 0, 0xFFFF), 1, "repetition counter");
+    assert_eq!(r("tim1_dier", 0, 1), 1, "UIE (deadline monitor)");
+    assert_eq!(r("tim1_arr", 0, 0xFFFF) + 1, u64::from(PWM_COUNTS));
+    assert_eq!(r("tim1_bdtr", 0, 0xFF), 85, "DTG");
+    assert_eq!((r("tim1_bdtr", 12, 1), r("tim1_bdtr", 13, 1)), (1, 1), "BKE, BKP active high");
+    assert_eq!(r("tim1_bdtr", 8, 3), 1, "LOCK level 1");
+    assert_eq!(r("tim1_af1", 1, 1), 1, "BKCMP1E: COMP1 into the break");
+    assert_eq!(r("syscfg_cfgr2", 0, 0xF), 0xF, "lockup, SRAM parity, PVD, flash ECC to the break");
+    // COMP1: enabled, inverting input DAC3 CH1, locked; DAC3 at the configured threshold.
+    assert_eq!((r("comp1_csr", 0, 1), r("comp1_csr", 4, 7), r("comp1_csr", 31, 1)), (1, 4, 1), "COMP1");
+    let cfg = default_image().expect("default image").control;
+    let threshold = firmware::bringup::over_current_counts(cfg.get()).expect("threshold");
+    assert_eq!(r("dac3_dhr12r1", 0, 0xFFF), u64::from(threshold), "DAC3 threshold from over_current");
+    assert_eq!((r("dac3_cr", 0, 1), r("dac3_mcr", 0, 7)), (1, 3), "DAC3 on, internal connection");
+    // Watchdog frozen under the debugger; 50 ms from LSI 32 kHz.
+    assert_eq!(r("dbgmcu_apb1fzr1", 12, 1), 1, "DBG_IWDG_STOP");
+    let wd_ms = (4u64 << r("iwdg_pr", 0, 7)) * (r("iwdg_rlr", 0, 0xFFF) + 1) / 32;
+    assert_eq!(wd_ms, 50, "IWDG timeout, ms");
+    // FDCAN: timing from the crystal, one filter for the command identifier into FIFO 0,
+    // everything else rejected.
+    let t = firmware::can_timing::nominal(24_000_000, 1_000_000).expect("timing");
+    assert_eq!(r("fdcan_nbtp", 16, 0x1FF) + 1, u64::from(t.prescaler), "NBRP");
+    assert_eq!(r("fdcan_nbtp", 8, 0xFF) + 1, u64::from(t.seg1), "NTSEG1");
+    assert_eq!(r("fdcan_nbtp", 0, 0x7F) + 1, u64::from(t.seg2), "NTSEG2");
+    assert_eq!(r("fdcan_nbtp", 25, 0x7F) + 1, u64::from(t.sjw), "NSJW");
+    assert_eq!((r("fdcan_rxgfc", 4, 3) >> 1, r("fdcan_rxgfc", 2, 3) >> 1), (1, 1), "non-matching rejected");
+    let flt = (r("fdcan_flssa0", 30, 3), r("fdcan_flssa0", 27, 7), r("fdcan_flssa0", 16, 0x7FF));
+    assert_eq!(flt, (1, 1, 0x120), "filter 0: command id into FIFO 0");
+    // The reset flags read and cleared.
+    assert_eq!(r("rcc_csr", 25, 0x7F), 0, "RMVF");
+    // Priorities: deadline monitor > control > CAN > time driver (lower value wins).
+    let prio = |irq: &str| regs["prio"][irq].as_u64().unwrap_or(0);
+    assert!(prio("25") < prio("18"), "TIM1_UP above ADC1_2");
+    assert!(prio("18") < prio("21") && prio("18") < prio("22"), "ADC1_2 above FDCAN");
+    assert!(prio("21") < prio("24"), "FDCAN above the time driver (TIM15)");
+    println!("bring-up registers: clocks, ADC, TIM1 break/lock, COMP1/DAC3, IWDG, FDCAN, priorities as configured");
+}
