@@ -108,8 +108,10 @@ fn inspect(slot: Slot) -> (SlotState, Option<(Loop, ValidatedConfig)>) {
     if slots::is_blank(&bytes) {
         return (SlotState::Blank, None);
     }
-    let Some(seq) = slots::sequence(&bytes) else {
-        return (SlotState::Unusable("no commit record (interrupted commit)"), None);
+    let seq = match slots::record_of(&bytes) {
+        slots::Record::Committed(seq) => seq,
+        slots::Record::Absent => 0,
+        slots::Record::Broken => return (SlotState::Unusable("commit record cut (interrupted commit)"), None),
     };
     let image = bytes.get(..slots::IMAGE_BYTES).unwrap_or(&[]);
     match ConfigImage::decode(image).and_then(|img| runnable(&img)) {

@@ -6,8 +6,10 @@
 //! double-word, the commit record: a sequence number and its complement. A commit erases
 //! the slot that is *not* running, programs the image, then programs the record with the
 //! running sequence + 1 as the very last operation. A slot counts only when its record
-//! is whole, its image decodes and validates, and no double-word of it read back with an
-//! uncorrectable ECC error; of two such slots the newer sequence (wrapping) boots.
+//! is whole (or erased: a page flashed by a probe without the protocol, such as the
+//! single page of earlier firmware at slot B's address, counts as sequence 0), its image
+//! decodes and validates, and no double-word of it read back with an uncorrectable ECC
+//! error; of two such slots the newer sequence (wrapping) boots, A on a tie.
 
 use model_core::control::page::PAGE_BYTES;
 
@@ -39,6 +41,27 @@ pub fn record(seq: u32) -> [u8; 8] {
     r[..4].copy_from_slice(&seq.to_le_bytes());
     r[4..].copy_from_slice(&(!seq).to_le_bytes());
     r
+}
+
+/// What the commit record of a slot says.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Record {
+    /// Whole, with this sequence.
+    Committed(u32),
+    /// Erased: a page written without the A/B protocol (`hil-sim export` + a probe); it
+    /// counts as sequence 0, the oldest, if its image is valid.
+    Absent,
+    /// Neither: a commit cut while writing its record.
+    Broken,
+}
+
+/// The commit record at the end of `slot`.
+pub fn record_of(slot: &[u8; SLOT_BYTES]) -> Record {
+    match (sequence(slot), slot.get(IMAGE_BYTES..).is_some_and(is_blank)) {
+        (Some(seq), _) => Record::Committed(seq),
+        (None, true) => Record::Absent,
+        (None, false) => Record::Broken,
+    }
 }
 
 /// The sequence of a whole commit record at the end of `slot`, if any.
@@ -162,6 +185,18 @@ mod tests {
             }
             running = Some((slot, seq));
         }
+    }
+
+    #[test]
+    fn a_page_without_record_is_the_oldest() {
+        let mut s = [0xFFu8; SLOT_BYTES];
+        s[..4].fill(7);
+        assert_eq!(record_of(&s), Record::Absent);
+        s[IMAGE_BYTES..].copy_from_slice(&record(2));
+        assert_eq!(record_of(&s), Record::Committed(2));
+        s[IMAGE_BYTES + 6] = 0;
+        assert_eq!(record_of(&s), Record::Broken);
+        assert_eq!(choose(SlotState::Valid(0), SlotState::Valid(1)), Boot::Slot(Slot::B, 1));
     }
 
     #[test]
