@@ -4,9 +4,9 @@
 //! from before the trip. The safe state therefore zeroes the compares, and enabling goes
 //! through [`Bridge::Arming`]: compares written, MOE set one period later.
 //!
-//! A stall latch ([`Bridge::Stalled`]) is set by the watchdog task when the control
-//! interrupt stops: the bridge stays off and the loop reports the fault until a reset
-//! command, even if the interrupt resumes.
+//! The stall latch (the firmware's `controller::STALLED`, set by the deadline monitor or
+//! the watchdog task when the control interrupt stops) keeps the step disabled and
+//! reporting an overrun fault until a reset command, even if the interrupt resumes.
 
 /// The bridge's state as the control interrupt sees it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
