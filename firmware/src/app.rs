@@ -261,14 +261,37 @@ async fn main(spawner: Spawner) {
     interrupt::FDCAN1_IT1.set_priority(Priority::P3);
     interrupt::TIM1_BRK_TIM15.set_priority(Priority::P4);
     board::enable_update_interrupt();
-    // SAFETY: the handlers only touch `CONTROL`/`PENDING` inside critical sections and
-    // the atomics; they are installed now that `CONTROL` holds the peripherals they drive.
+    // SAFETY: the handlers touch `CONTROL`/`PENDING`/`TELEMETRY` and the atomics only (see
+    // `controller::ADC1_2` for why it needs no masking); they are installed now that
+    // `CONTROL` holds the peripherals they drive.
     unsafe {
         interrupt::ADC1_2.enable();
         interrupt::TIM1_UP_TIM16.enable();
     }
 
-    let mut can = CanConfigurator::new(b.can, b.can_rx, b.can_tx, Irqs);
+    let can = start_can(b.can, b.can_rx, b.can_tx);
+
+    let iwdg = IndependentWatchdog::new(b.iwdg, board::WATCHDOG_US);
+    match (telemetry(), commands(can, loaded.running), supervisor()) {
+        (Ok(t), Ok(c), Ok(s)) => {
+            spawner.spawn(t);
+            spawner.spawn(c);
+            spawner.spawn(s);
+        }
+        _ => fatal("spawning tasks"),
+    }
+    info!("running");
+    watchdog(iwdg).await;
+}
+
+/// FDCAN1 in normal mode: bit timing from the crystal (`firmware::can_timing`), one
+/// standard filter for `CAN_ID_CMD` into FIFO 0, every other frame rejected.
+fn start_can(
+    can: embassy_stm32::Peri<'static, FDCAN1>,
+    rx: embassy_stm32::Peri<'static, embassy_stm32::peripherals::PA11>,
+    tx: embassy_stm32::Peri<'static, embassy_stm32::peripherals::PA12>,
+) -> embassy_stm32::can::Can<'static> {
+    let mut can = CanConfigurator::new(can, rx, tx, Irqs);
     let Some(t) = firmware::can_timing::nominal(board::HSE_HZ, board::CAN_BITRATE) else {
         fatal("no exact CAN bit timing from the crystal")
     };
@@ -291,19 +314,7 @@ async fn main(spawner: Spawner) {
         StandardFilterSlot::_0,
         StandardFilter { filter: FilterType::DedicatedSingle(cmd_id), action: Action::StoreInFifo0 },
     );
-    let can = can.into_normal_mode();
-
-    let iwdg = IndependentWatchdog::new(b.iwdg, board::WATCHDOG_US);
-    match (telemetry(), commands(can, loaded.running), supervisor()) {
-        (Ok(t), Ok(c), Ok(s)) => {
-            spawner.spawn(t);
-            spawner.spawn(c);
-            spawner.spawn(s);
-        }
-        _ => fatal("spawning tasks"),
-    }
-    info!("running");
-    watchdog(iwdg).await;
+    can.into_normal_mode()
 }
 
 /// Pet the independent watchdog only while the control interrupt keeps running: a stalled
