@@ -100,6 +100,9 @@ fn source_code(running: Option<(Slot, u32)>, damaged: bool) -> u32 {
     }
 }
 
+/// Started with no usable configuration (the loop is held in a fault until a commit).
+static DAMAGED: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
+
 /// What one slot holds.
 fn inspect(slot: Slot) -> (SlotState, Option<(Loop, ValidatedConfig)>) {
     let Ok(bytes) = flash::read_slot(slot) else {
@@ -239,6 +242,7 @@ async fn main(spawner: Spawner) {
     );
 
     if loaded.damaged {
+        DAMAGED.store(true, Ordering::Relaxed);
         controller::STALLED.store(true, Ordering::Relaxed);
     }
     critical_section::with(|cs| {
@@ -497,8 +501,10 @@ async fn commit(page: &mut PageAssembler, crc: u32, running: Option<(Slot, u32)>
         }
     }
     critical_section::with(|cs| controller::PENDING.borrow_ref_mut(cs).replace((lp, cfg)));
-    // A damaged board runs again once a good page is committed.
-    controller::RESET.store(true, Ordering::Relaxed);
+    // A board held by a damaged configuration runs again once a good page is committed.
+    if DAMAGED.swap(false, Ordering::Relaxed) {
+        controller::RESET.store(true, Ordering::Relaxed);
+    }
     CONFIG_SOURCE.store(source_code(Some((slot, seq)), false), Ordering::Relaxed);
     info!("new configuration: model {}, slot {} commit {}", img.model_id(), slot, seq);
     Ok((slot, seq))

@@ -114,8 +114,9 @@ pub static RESET: AtomicBool = AtomicBool::new(false);
 /// Samples processed and overruns since start-up.
 pub static SAMPLES: AtomicU32 = AtomicU32::new(0);
 pub static OVERRUNS: AtomicU32 = AtomicU32::new(0);
-/// The control interrupt stopped (deadline monitor or watchdog task): the bridge stays
-/// off and the step is told of an overrun until a reset command.
+/// The control interrupt stopped (deadline monitor or watchdog task), or no usable
+/// configuration: the bridge stays off and the step is told of an overrun (so it latches
+/// the `Overrun` fault when enabled) until a reset command.
 pub static STALLED: AtomicBool = AtomicBool::new(false);
 /// A slow pass is due (set by the supervisor task, taken by the control interrupt).
 static SLOW_DUE: AtomicBool = AtomicBool::new(false);
@@ -172,10 +173,10 @@ pub fn safe_state() {
 }
 
 /// Write the bridge for one step's output: compares first, MOE a period later
-/// ([`firmware::bridge`]).
+/// ([`firmware::bridge`]); never while the stall is latched.
 #[inline(always)]
-fn drive(c: &mut Control, out: &ControlOutput) {
-    let (next, action) = c.bridge.next(out.pwm_enable);
+fn drive(c: &mut Control, out: &ControlOutput, stalled: bool) {
+    let (next, action) = c.bridge.next(out.pwm_enable && !stalled);
     c.bridge = next;
     match action {
         bridge::Action::Off => safe_state(),
@@ -236,14 +237,17 @@ fn ADC1_2() {
             STALLED.store(false, Ordering::Relaxed);
         }
         let stalled = STALLED.load(Ordering::Relaxed);
+        // A latched stall is an overrun for the step (it trips `Overrun` after
+        // `confirm_samples` if enabled, so the mode reads a fault, not Running) and the
+        // bridge stays off meanwhile.
         let input = ControlInput {
             overrun: c.overrun || stalled,
-            enable: ENABLE.load(Ordering::Relaxed) && !stalled,
+            enable: ENABLE.load(Ordering::Relaxed),
             reset,
             ..ControlInput::new(hall, current, supply_v, reference)
         };
         let out = c.lp.step(&c.cfg, input);
-        drive(c, &out);
+        drive(c, &out, stalled);
         let n = SAMPLES.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
         RUNNING.store(true, Ordering::Relaxed);
         let cycles = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);

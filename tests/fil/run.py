@@ -289,7 +289,17 @@ def powercut(elf, flash_path, page_path):
             print("cut %d: boots %r" % (cut, got))
     print("power cut: %d of %d interrupted commits boot the old or the new page (%s)"
           % (good, ops, ", ".join("%s/%d: %d" % (k[0], k[1], v) for k, v in sorted(seen.items()))))
-    return [good == ops]
+    # Never silently: the old page's CRC broken (a flipped bit), slot B blank → the
+    # defaults, reported as damaged, and the drive refused.
+    bad = bytearray(flash)
+    bad[100] ^= 0x01
+    m = g474.Machine(elf, flash_image=bytes(bad))
+    boot(m)
+    got = source(m)
+    drove = running(m)
+    loud = got == ("damaged", 0) and not drove
+    print("damaged slot, other blank: boots %r, bridge %s" % (got, "DRIVEN" if drove else "held off"))
+    return [good == ops, loud]
 
 
 def board(elf):
