@@ -35,38 +35,6 @@ pub fn ln(x: f32) -> f32 {
 pub fn expm1(x: f32) -> f32 {
     libm::expm1f(x)
 }
-/// `tan x` for `0 ≤ x < π/2` in f32 arithmetic only (libm's `tanf` evaluates its kernel in
-/// f64, which is soft-float on the Cortex-M4F: 2–3k cycles of `__aeabi_d*` calls in the
-/// control interrupt). Above π/4 it is `1/tan(π/2 − x)`, the subtraction exact (Sterbenz)
-/// with π/2 split in two f32 parts; `sin y / cos y` by their Taylor series to y¹¹ and y¹²
-/// on `|y| ≤ π/4` (truncation below 4e-9). Relative error ≤ 1e-6 (tested against f64).
-/// Negative input is treated as 0; at and beyond π/2 the result is `f32::MAX`.
-#[inline]
-pub fn tan_first_quadrant(x: f32) -> f32 {
-    // π/2 = PIO2_HI + PIO2_LO, PIO2_HI the f32 nearest to π/2 (above it).
-    const PIO2_HI: f32 = 1.570_796_4;
-    const PIO2_LO: f32 = -4.371_139e-8;
-    let x = if x > 0.0 { x } else { 0.0 };
-    if x <= core::f32::consts::FRAC_PI_4 {
-        return tan_kernel(x);
-    }
-    let y = (PIO2_HI - x) + PIO2_LO;
-    if y > 0.0 {
-        1.0 / tan_kernel(y)
-    } else {
-        f32::MAX
-    }
-}
-
-/// `sin y / cos y` for `|y| ≤ π/4` (nested Taylor series, f32 only).
-#[inline(always)]
-fn tan_kernel(y: f32) -> f32 {
-    let y2 = y * y;
-    let s = y * (1.0 - y2 / 6.0 * (1.0 - y2 / 20.0 * (1.0 - y2 / 42.0 * (1.0 - y2 / 72.0 * (1.0 - y2 / 110.0)))));
-    let c = 1.0
-        - y2 / 2.0 * (1.0 - y2 / 12.0 * (1.0 - y2 / 30.0 * (1.0 - y2 / 56.0 * (1.0 - y2 / 90.0 * (1.0 - y2 / 132.0)))));
-    s / c
-}
 /// `e^{−y}` for `0 ≤ y ≤ 64` without libm (the hot paths of the stateless models): `2^t`
 /// with `t = −y·log₂e` split into a nearest integer n and `f ∈ [−½, ½]`, `2^f = e^{f·ln 2}`
 /// by its Taylor series to the 6th power (relative error ≤ 4e-7 + 8e-8·y, the second

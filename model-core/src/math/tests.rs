@@ -52,19 +52,3 @@ fn symmetric_clamp_limits_and_zeroes_nan() {
     assert_eq!(clamp_symmetric(f32::NAN, 1.0), 0.0);
     assert_eq!(clamp_symmetric(f32::NEG_INFINITY, 2.0), -2.0);
 }
-
-#[test]
-fn first_quadrant_tan_matches_f64() {
-    let mut worst = 0.0f64;
-    let top = core::f32::consts::FRAC_PI_2;
-    for i in 0..=400_000 {
-        let x = top * i as f32 / 400_001.0;
-        let want = f64::from(x).tan();
-        let got = f64::from(tan_first_quadrant(x));
-        let rel = if want == 0.0 { got.abs() } else { ((got - want) / want).abs() };
-        worst = worst.max(rel);
-    }
-    assert!(worst < 1e-6, "tan relative error {worst}");
-    assert_eq!(tan_first_quadrant(-1.0), 0.0);
-    assert_eq!(tan_first_quadrant(2.0), f32::MAX);
-}
