@@ -64,13 +64,18 @@ pub struct Report {
 }
 
 impl Report {
-    /// Steps that miss their budget, with the reasons.
+    /// Steps that miss their budget, with the reasons; and f64 soft-float reachable from a
+    /// firmware interrupt.
     pub fn exceeded(&self) -> Vec<String> {
-        self.named(StepFigures::excess)
+        let mut v = self.named(StepFigures::excess);
+        if let Some(i) = &self.interrupts {
+            v.extend(i.warnings());
+        }
+        v
     }
 
     /// Steps over the ceiling `--check` enforces, with the reasons; and what the firmware's
-    /// interrupts may not do (f64 soft-float, masking, step + slow pass beyond a period).
+    /// interrupts may not do (mask interrupts, step + slow pass beyond a period).
     pub fn over_ceiling(&self) -> Vec<String> {
         let mut v = self.named(StepFigures::over_ceiling);
         if let Some(i) = &self.interrupts {
