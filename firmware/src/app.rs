@@ -1,11 +1,16 @@
 //! The embassy application (bare-metal target only).
 //!
-//! Start-up: clocks (170 MHz), the bridge in its safe state, the configuration page from
-//! flash (or the compiled-in defaults when it is blank or invalid), TIM1 centre-aligned
-//! complementary PWM with dead time whose TRGO2 (update event, once per period via the
-//! repetition counter) starts ADC1's injected sequence (Hall, coil current, supply), the
-//! control interrupt at the highest priority ([`crate::controller`]), then three tasks:
-//! CAN commands ([`model_core::protocol`]), decimated defmt telemetry, and the watchdog.
+//! Start-up: clocks (170 MHz from the 24 MHz crystal; ADC kernel clock PLL P, FDCAN
+//! kernel clock HSE), the reset cause, the watchdog frozen under a debugger, the
+//! configuration from the newer valid A/B slot ([`firmware::slots`]; the compiled-in
+//! defaults on a blank board, reported as a fault when the slots hold something unusable),
+//! TIM1 centre-aligned complementary PWM with dead time whose TRGO2 (update event at the
+//! counter underflow, once per period via the repetition counter) starts ADC1's injected
+//! sequence (Hall, coil current, supply), the comparator over-current trip into TIM1's
+//! break and BDTR locked, the interrupts (deadline monitor above the control interrupt,
+//! above CAN, above the time driver; [`crate::controller`]), then four tasks: CAN commands
+//! ([`model_core::protocol`], with the command timeout of [`firmware::link`]), the
+//! supervisor's slow-pass requests, decimated defmt telemetry, and the watchdog.
 
 use core::sync::atomic::Ordering;
 
@@ -13,8 +18,9 @@ use defmt::{error, info, warn};
 use defmt_rtt as _;
 use embassy_executor::Spawner;
 use embassy_stm32::adc::{Adc, AdcConfig, Exten, SampleTime};
+use embassy_stm32::can::config::{GlobalFilter, NominalBitTiming};
+use embassy_stm32::can::filter::{Action, FilterType, StandardFilter, StandardFilterSlot};
 use embassy_stm32::can::{self, CanConfigurator};
-use embassy_stm32::flash::{Blocking, Flash};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::peripherals::FDCAN1;
 use embassy_stm32::time::Hertz;
@@ -23,41 +29,46 @@ use embassy_stm32::timer::low_level::CountingMode;
 use embassy_stm32::timer::Channel;
 use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::{bind_interrupts, interrupt, Config};
-use embassy_time::{Duration, Ticker, Timer};
-use model_core::control::page::PAGE_BYTES;
-use model_core::control::ConfigImage;
+use embassy_time::{Duration, Instant, Ticker, Timer};
+use firmware::bringup::{self, BoardMismatch};
+use firmware::link::{LinkAction, LinkWatch};
+use firmware::slots::{self, Boot, Slot, SlotState};
+use model_core::control::{ConfigImage, PageError, ValidatedConfig};
 use model_core::protocol::{mode_code, Command, Nack, PageAssembler, Response, FRAME};
 
-use crate::board::{self, Board};
+use crate::board::{self, flash, Board};
 use crate::controller::{self, Control, Loop, Snapshot};
+use crate::safety::fatal;
 
 bind_interrupts!(struct Irqs {
     FDCAN1_IT0 => can::IT0InterruptHandler<FDCAN1>;
     FDCAN1_IT1 => can::IT1InterruptHandler<FDCAN1>;
 });
 
-/// Clock tree: 16 MHz HSI / 4 × 85 = 340 MHz VCO, / 2 on PLL R = 170 MHz SYSCLK, with
-/// range-1 boost mode (required above 150 MHz). AHB/APB1/APB2 undivided (170 MHz), so TIM1
-/// counts at 170 MHz. For a board crystal, set `rcc.hse` and `PllSource::HSE` with a prediv
-/// giving the same 4 MHz PLL input (e.g. 24 MHz HSE / 6).
+/// Clock tree: the Nucleo's 24 MHz crystal / 6 × 85 = 340 MHz VCO; / 2 on PLL R = 170 MHz
+/// SYSCLK, with range-1 boost mode (required above 150 MHz); / 8 on PLL P = 42.5 MHz for
+/// the ADC kernel clock (≤ 60 MHz; embassy's default mux leaves `adc12sel` disabled and
+/// `Adc::new` would panic). FDCAN's kernel clock is the crystal itself (24 MHz: 24 time
+/// quanta a bit at 1 Mbit/s, crystal accuracy; `fdcansel` resets to HSE, which must be
+/// on). AHB/APB1/APB2 undivided (170 MHz), so TIM1 counts at 170 MHz.
 fn clocks() -> Config {
-    use embassy_stm32::rcc::{Pll, PllMul, PllPreDiv, PllRDiv, PllSource, Sysclk};
+    use embassy_stm32::rcc::{mux, Hse, HseMode, Pll, PllMul, PllPDiv, PllPreDiv, PllRDiv, PllSource, Sysclk};
     let mut config = Config::default();
-    config.rcc.hsi = true;
+    config.rcc.hse = Some(Hse { freq: Hertz(board::HSE_HZ), mode: HseMode::Oscillator });
     config.rcc.pll = Some(Pll {
-        source: PllSource::HSI,
-        prediv: PllPreDiv::DIV4,
+        source: PllSource::HSE,
+        prediv: PllPreDiv::DIV6,
         mul: PllMul::MUL85,
-        divp: None,
+        divp: Some(PllPDiv::DIV8),
         divq: None,
         divr: Some(PllRDiv::DIV2),
     });
     config.rcc.sys = Sysclk::PLL1_R;
     config.rcc.boost = true;
+    config.rcc.mux.adc12sel = mux::Adcsel::PLL1_P;
+    config.rcc.mux.fdcansel = mux::Fdcansel::HSE;
     config
 }
-
-const CORE_HZ: u32 = 170_000_000;
 
 /// A page error for the log (a name: formatting the numbers in it would pull core's float
 /// formatting into flash; `hil-sim export` gives the full message on the host).
@@ -73,43 +84,110 @@ fn page_error(e: &model_core::control::PageError) -> &'static str {
     }
 }
 
-/// The stored page, or the defaults when it is blank or invalid.
-fn load_config(flash: &mut Flash<'static, Blocking>) -> (Loop, model_core::control::ValidatedConfig) {
-    let mut buf = [0u8; PAGE_BYTES];
-    let stored = match flash.blocking_read(board::CONFIG_PAGE_OFFSET, &mut buf) {
-        Ok(()) => ConfigImage::decode(&buf).and_then(|img| Loop::from_image(&img).map(|lp| (lp, img.control))),
-        Err(_) => Err(model_core::control::PageError::Malformed("flash read")),
+/// Which configuration runs, for telemetry and the firmware-in-the-loop test:
+/// `seq << 2 | slot` with slot 1 = A, 2 = B; 0 = compiled-in defaults on a blank board,
+/// 3 = defaults because the slots are damaged. `#[used]`: kept (and its stores with it)
+/// for the debugger and the emulator, which read it by symbol.
+#[used]
+pub static CONFIG_SOURCE: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
+
+fn source_code(running: Option<(Slot, u32)>, damaged: bool) -> u32 {
+    match running {
+        Some((Slot::A, seq)) => seq << 2 | 1,
+        Some((Slot::B, seq)) => seq << 2 | 2,
+        None if damaged => 3,
+        None => 0,
+    }
+}
+
+/// Started with no usable configuration (the loop is held in a fault until a commit).
+static DAMAGED: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
+
+/// What one slot holds.
+fn inspect(slot: Slot) -> (SlotState, Option<(Loop, ValidatedConfig)>) {
+    let Ok(bytes) = flash::read_slot(slot) else {
+        return (SlotState::Unusable("uncorrectable ECC error"), None);
     };
-    match stored {
-        Ok(c) => {
-            info!("configuration page loaded");
-            c
-        }
-        Err(e) => {
-            warn!("configuration page not used ({}); compiled-in defaults", page_error(&e));
-            match controller::default_image().and_then(|img| Loop::from_image(&img).map(|lp| (lp, img.control))) {
-                Ok(c) => c,
-                Err(e) => defmt::panic!("compiled-in configuration rejected: {}", page_error(&e)),
-            }
-        }
+    if slots::is_blank(&bytes) {
+        return (SlotState::Blank, None);
+    }
+    let seq = match slots::record_of(&bytes) {
+        slots::Record::Committed(seq) => seq,
+        slots::Record::Absent => 0,
+        slots::Record::Broken => return (SlotState::Unusable("commit record cut (interrupted commit)"), None),
+    };
+    let image = bytes.get(..slots::IMAGE_BYTES).unwrap_or(&[]);
+    match ConfigImage::decode(image).and_then(|img| runnable(&img)) {
+        Ok(c) => (SlotState::Valid(seq), Some(c)),
+        Err(e) => (SlotState::Unusable(page_error(&e)), None),
+    }
+}
+
+/// A decoded page as a controller, checked against the board.
+fn runnable(img: &ConfigImage) -> Result<(Loop, ValidatedConfig), PageError> {
+    bringup::check_board(&img.control, board::PWM_COUNTS).map_err(|m| match m {
+        BoardMismatch::PwmCounts => PageError::Malformed("pwm_counts is not the timer's"),
+        BoardMismatch::SamplePeriod => PageError::Malformed("dt is not the control period"),
+        BoardMismatch::OverCurrentRange => PageError::Malformed("over_current beyond the comparator"),
+    })?;
+    Loop::from_image(img).map(|lp| (lp, img.control))
+}
+
+/// The configuration that boots: the newer valid slot, or the defaults (blank board), or
+/// the defaults with the loop held in a fault until a valid page is committed.
+struct Loaded {
+    lp: Loop,
+    cfg: ValidatedConfig,
+    running: Option<(Slot, u32)>,
+    damaged: bool,
+}
+
+fn load_config() -> Loaded {
+    let (sa, ca) = inspect(Slot::A);
+    let (sb, cb) = inspect(Slot::B);
+    info!("configuration slots: A {}, B {}", sa, sb);
+    let boot = slots::choose(sa, sb);
+    let chosen = match boot {
+        Boot::Slot(Slot::A, _) => ca,
+        Boot::Slot(Slot::B, _) => cb,
+        Boot::Blank | Boot::Damaged => None,
+    };
+    if let (Boot::Slot(slot, seq), Some((lp, cfg))) = (boot, chosen) {
+        info!("configuration slot {} (commit {}) loaded", slot, seq);
+        return Loaded { lp, cfg, running: Some((slot, seq)), damaged: false };
+    }
+    let damaged = boot == Boot::Damaged;
+    if damaged {
+        error!("CONFIGURATION DAMAGED: no usable slot; compiled-in defaults, drive refused until a commit");
+    } else {
+        info!("blank configuration slots: compiled-in defaults");
+    }
+    match controller::default_image().and_then(|img| runnable(&img)) {
+        Ok((lp, cfg)) => Loaded { lp, cfg, running: None, damaged },
+        Err(_) => fatal("compiled-in configuration rejected"),
     }
 }
 
 #[embassy_executor::main]
 async fn main(spawner: Spawner) {
     let p = embassy_stm32::init(clocks());
+    // Until TIM1 is set up its outputs are GPIO inputs (the gate drivers' pull-downs keep
+    // the bridge off); from then on MOE is off until the first enabled step.
     let b = Board::new(p);
-    info!("MR clutch controller, SYSCLK 170 MHz, control {} Hz", board::CONTROL_HZ);
+    let cause = board::reset_cause();
+    board::freeze_watchdog_in_debug();
+    info!("MR clutch controller, SYSCLK 170 MHz, control {} Hz, reset cause {}", board::CONTROL_HZ, cause);
+    if cause.is_fault() {
+        error!("RESET BY {}: the previous run stopped with the bridge switching", cause);
+    }
 
-    let mut cp = match cortex_m::Peripherals::take() {
-        Some(cp) => cp,
-        None => defmt::panic!("core peripherals taken"),
-    };
+    let Some(mut cp) = cortex_m::Peripherals::take() else { fatal("core peripherals taken") };
     cp.DCB.enable_trace();
     cp.DWT.enable_cycle_counter();
 
-    let mut flash = Flash::new_blocking(b.flash);
-    let (lp, cfg) = load_config(&mut flash);
+    let loaded = load_config();
+    CONFIG_SOURCE.store(source_code(loaded.running, loaded.damaged), Ordering::Relaxed);
+    let _flash_owner = b.flash;
 
     // Bridge: centre-aligned PWM at CONTROL_HZ, complementary outputs with dead time,
     // all switches off when the main output is disabled (OSSI/OSSR, idle level low).
@@ -132,58 +210,115 @@ async fn main(spawner: Spawner) {
     pwm.set_off_state_selection_idle(Ossi::IDLE_LEVEL);
     pwm.set_off_state_selection_run(Ossr::IDLE_LEVEL);
     pwm.set_dead_time(board::DEAD_TIME_DTG);
-    // One update event per PWM period (at the counter underflow: the centre of the
-    // high-side on-time), which is TRGO2 for the ADC.
-    pwm.set_repetition_counter(1);
     pwm.set_mms2(Mms2::UPDATE);
     pwm.set_duty(Channel::Ch1, 0);
     pwm.set_duty(Channel::Ch2, 0);
     pwm.enable(Channel::Ch1);
     pwm.enable(Channel::Ch2);
+    // One update event per PWM period at the counter underflow (the centre of the
+    // high-side on-time), whatever the calls above did to the counter: stop, count from
+    // 0 up, repetition counter 1, load it with UG, start ([`board::align_update`]).
+    board::align_update(1);
     controller::safe_state();
-    let max_duty = pwm.get_max_duty();
-    info!("PWM: {} counts for duty 1 (config pwm_counts {})", max_duty, cfg.get().pwm_counts as u32);
+    // Centre-aligned: a compare of ARR + 1 keeps the output active the whole period.
+    let max_duty = pwm.get_max_duty() + 1;
+    if max_duty != board::PWM_COUNTS {
+        fatal("TIM1 counts for duty 1 differ from firmware::bringup::PWM_COUNTS");
+    }
+    let threshold = bringup::over_current_counts(loaded.cfg.get()).unwrap_or(4095);
+    board::arm_break(threshold);
+    board::lock_bridge_config();
+    info!("PWM: {} counts for duty 1; over-current comparator at {} counts", max_duty, threshold);
 
-    // ADC1 injected sequence started by TIM1 TRGO2, end-of-sequence interrupt.
+    // ADC1 injected sequence started by TIM1 TRGO2 (rising edge of the update pulse),
+    // end-of-sequence interrupt. The supply's divider (10 kΩ / 1 kΩ ≈ 909 Ω source) gets
+    // 47.5 cycles (1.1 µs at 42.5 MHz) to charge the sampling capacitor to 12 bits.
     let adc = Adc::new(b.adc, AdcConfig::default());
     let adc = adc.setup_injected_conversions(
-        [(b.hall, SampleTime::CYCLES12_5), (b.current, SampleTime::CYCLES12_5), (b.supply, SampleTime::CYCLES12_5)],
+        [(b.hall, SampleTime::CYCLES12_5), (b.current, SampleTime::CYCLES12_5), (b.supply, SampleTime::CYCLES47_5)],
         embassy_stm32::triggers::TIM1_TRGO2,
         Exten::RISING_EDGE,
         true,
     );
 
+    if loaded.damaged {
+        DAMAGED.store(true, Ordering::Relaxed);
+        controller::STALLED.store(true, Ordering::Relaxed);
+    }
     critical_section::with(|cs| {
         controller::CONTROL.borrow_ref_mut(cs).replace(Control {
-            lp,
-            cfg,
-            pwm,
+            lp: loaded.lp,
+            cfg: loaded.cfg,
+            _pwm: pwm,
             adc,
             max_duty,
-            period_cycles: CORE_HZ / board::CONTROL_HZ,
+            period_cycles: board::CORE_HZ / board::CONTROL_HZ,
             overrun: false,
-            driving: false,
+            bridge: firmware::bridge::Bridge::Off,
         });
     });
-    interrupt::ADC1_2.set_priority(Priority::P0);
-    // SAFETY: the handler only touches `CONTROL`/`PENDING` inside critical sections and
-    // the atomics; it is installed now that `CONTROL` holds the peripherals it drives.
-    unsafe { interrupt::ADC1_2.enable() };
+    // Priorities (lower is more urgent): the deadline monitor, then the control step,
+    // then CAN, then the time driver (TIM15, sharing its vector with TIM1's break).
+    interrupt::TIM1_UP_TIM16.set_priority(Priority::P0);
+    interrupt::ADC1_2.set_priority(Priority::P1);
+    interrupt::FDCAN1_IT0.set_priority(Priority::P3);
+    interrupt::FDCAN1_IT1.set_priority(Priority::P3);
+    interrupt::TIM1_BRK_TIM15.set_priority(Priority::P4);
+    board::enable_update_interrupt();
+    // SAFETY: the handlers touch `CONTROL`/`PENDING`/`TELEMETRY` and the atomics only (see
+    // `controller::ADC1_2` for why it needs no masking); they are installed now that
+    // `CONTROL` holds the peripherals they drive.
+    unsafe {
+        interrupt::ADC1_2.enable();
+        interrupt::TIM1_UP_TIM16.enable();
+    }
 
-    let mut can = CanConfigurator::new(b.can, b.can_rx, b.can_tx, Irqs);
-    can.set_bitrate(board::CAN_BITRATE);
-    let can = can.into_normal_mode();
+    let can = start_can(b.can, b.can_rx, b.can_tx);
 
     let iwdg = IndependentWatchdog::new(b.iwdg, board::WATCHDOG_US);
-    match (telemetry(), commands(can, flash), supervisor()) {
+    match (telemetry(), commands(can, loaded.running), supervisor()) {
         (Ok(t), Ok(c), Ok(s)) => {
             spawner.spawn(t);
             spawner.spawn(c);
             spawner.spawn(s);
         }
-        _ => defmt::panic!("spawning tasks"),
+        _ => fatal("spawning tasks"),
     }
+    info!("running");
     watchdog(iwdg).await;
+}
+
+/// FDCAN1 in normal mode: bit timing from the crystal (`firmware::can_timing`), one
+/// standard filter for `CAN_ID_CMD` into FIFO 0, every other frame rejected.
+fn start_can(
+    can: embassy_stm32::Peri<'static, FDCAN1>,
+    rx: embassy_stm32::Peri<'static, embassy_stm32::peripherals::PA11>,
+    tx: embassy_stm32::Peri<'static, embassy_stm32::peripherals::PA12>,
+) -> embassy_stm32::can::Can<'static> {
+    let mut can = CanConfigurator::new(can, rx, tx, Irqs);
+    let Some(t) = firmware::can_timing::nominal(board::HSE_HZ, board::CAN_BITRATE) else {
+        fatal("no exact CAN bit timing from the crystal")
+    };
+    let timing = (
+        core::num::NonZeroU16::new(t.prescaler),
+        core::num::NonZeroU8::new(t.seg1),
+        core::num::NonZeroU8::new(t.seg2),
+        core::num::NonZeroU8::new(t.sjw),
+    );
+    let (Some(prescaler), Some(seg1), Some(seg2), Some(sync_jump_width)) = timing else {
+        fatal("CAN bit timing out of range")
+    };
+    let config = can
+        .config()
+        .set_nominal_bit_timing(NominalBitTiming { prescaler, seg1, seg2, sync_jump_width })
+        .set_global_filter(GlobalFilter::reject_all());
+    can.set_config(config);
+    let Some(cmd_id) = embedded_can::StandardId::new(board::CAN_ID_CMD) else { fatal("CAN id") };
+    can.properties().set_standard_filter(
+        StandardFilterSlot::_0,
+        StandardFilter { filter: FilterType::DedicatedSingle(cmd_id), action: Action::StoreInFifo0 },
+    );
+    can.into_normal_mode()
 }
 
 /// Pet the independent watchdog only while the control interrupt keeps running: a stalled
@@ -195,24 +330,31 @@ async fn watchdog(mut iwdg: IndependentWatchdog<'static, embassy_stm32::peripher
     loop {
         ticker.next().await;
         let now = controller::SAMPLES.load(Ordering::Relaxed);
-        if now != last {
+        if now != last && !controller::STALLED.load(Ordering::Relaxed) {
             iwdg.pet();
-        } else {
+        } else if now == last {
+            // Bridge off and the stall latched, so the loop reports it (the mode does not
+            // read Running with the bridge off) should the interrupt come back.
             controller::safe_state();
+            controller::STALLED.store(true, Ordering::Relaxed);
             error!("control interrupt stalled: bridge off, watchdog will reset");
+        } else {
+            // Stalled but sampling again (deadline monitor, damaged configuration): the
+            // loop holds the bridge off in its fault; keep the watchdog fed.
+            iwdg.pet();
         }
         last = now;
     }
 }
 
-/// The slow supervisor pass of the control step at `SLOW_HZ` (configuration fingerprint
-/// and time step; the step trips `SupervisorStalled` if this task stops).
+/// Requests the slow supervisor pass of the control step at `SLOW_HZ` (run by the control
+/// interrupt after a compare write; the step trips `SupervisorStalled` if this task stops).
 #[embassy_executor::task]
 async fn supervisor() {
     let mut ticker = Ticker::every(Duration::from_hz(controller::SLOW_HZ));
     loop {
         ticker.next().await;
-        controller::slow_pass();
+        controller::request_slow_pass();
     }
 }
 
@@ -252,14 +394,26 @@ fn reply(r: Response) -> Option<embassy_stm32::can::Frame> {
     embassy_stm32::can::Frame::new_standard(board::CAN_ID_REPLY, buf.get(..n)?).ok()
 }
 
-/// CAN commands (protocol in `model_core::protocol`).
+/// CAN commands (protocol in `model_core::protocol`). The acceptance filter lets only
+/// `CAN_ID_CMD` into the FIFO. A drive enabled with no command for `COMMAND_TIMEOUT_MS`
+/// is released (`firmware::link`).
 #[embassy_executor::task]
-async fn commands(mut can: embassy_stm32::can::Can<'static>, mut flash: Flash<'static, Blocking>) {
+async fn commands(mut can: embassy_stm32::can::Can<'static>, mut running: Option<(Slot, u32)>) {
     let mut page = PageAssembler::default();
+    let now_ms = || Instant::now().as_millis();
+    let mut link = LinkWatch::new(board::COMMAND_TIMEOUT_MS, now_ms());
     loop {
-        let env = match can.read().await {
-            Ok(env) => env,
-            Err(e) => {
+        let wait = Duration::from_millis(board::COMMAND_TIMEOUT_MS / 4);
+        let got = embassy_time::with_timeout(wait, can.read()).await;
+        if link.poll(now_ms(), controller::ENABLE.load(Ordering::Relaxed)) == LinkAction::Release {
+            controller::ENABLE.store(false, Ordering::Relaxed);
+            controller::REFERENCE.store(0, Ordering::Relaxed);
+            warn!("no command for {} ms: drive released", board::COMMAND_TIMEOUT_MS);
+        }
+        let env = match got {
+            Err(_timeout) => continue,
+            Ok(Ok(env)) => env,
+            Ok(Err(e)) => {
                 warn!("CAN: {}", e);
                 Timer::after_millis(1).await;
                 continue;
@@ -274,7 +428,11 @@ async fn commands(mut can: embassy_stm32::can::Can<'static>, mut flash: Flash<'s
         }
         let data = env.frame.data();
         let code = data.first().copied().unwrap_or(0);
-        let answer = match Command::decode(data) {
+        let decoded = Command::decode(data);
+        if decoded.is_ok() {
+            link.heard(now_ms());
+        }
+        let answer = match decoded {
             Err(why) => Some(Response::Nack(code, why)),
             Ok(Command::SetTorque(t)) => {
                 controller::REFERENCE.store(t.to_bits(), Ordering::Relaxed);
@@ -306,10 +464,13 @@ async fn commands(mut can: embassy_stm32::can::Can<'static>, mut flash: Flash<'s
                 .data(offset, data.get(..usize::from(len)).unwrap_or(&[]))
                 .err()
                 .map(|why| Response::Nack(code, why)),
-            Ok(Command::ConfigCommit { crc }) => Some(
-                commit(&mut page, crc, &mut flash)
-                    .map_or_else(|why| Response::Nack(code, why), |()| Response::Ack(code)),
-            ),
+            Ok(Command::ConfigCommit { crc }) => Some(match commit(&mut page, crc, running).await {
+                Ok(now) => {
+                    running = Some(now);
+                    Response::Ack(code)
+                }
+                Err(why) => Response::Nack(code, why),
+            }),
         };
         if let Some(frame) = answer.and_then(reply) {
             can.write(&frame).await;
@@ -317,17 +478,34 @@ async fn commands(mut can: embassy_stm32::can::Can<'static>, mut flash: Flash<'s
     }
 }
 
-/// Validate the received page, write it to flash, hand it to the control interrupt.
-fn commit(page: &mut PageAssembler, crc: u32, flash: &mut Flash<'static, Blocking>) -> Result<(), Nack> {
+/// Validate the received page, write it to the slot not running (erase, image, commit
+/// record last; the waits yield, so the control interrupt and the watchdog task keep
+/// running), read it back, hand it to the control interrupt.
+async fn commit(page: &mut PageAssembler, crc: u32, running: Option<(Slot, u32)>) -> Result<(Slot, u32), Nack> {
     if controller::ENABLE.load(Ordering::Relaxed) {
         return Err(Nack::Busy);
     }
     let (bytes, img) = page.commit(crc)?;
-    let lp = Loop::from_image(&img).map_err(|_| Nack::InvalidPage)?;
-    let from = board::CONFIG_PAGE_OFFSET;
-    flash.blocking_erase(from, from + PAGE_BYTES as u32).map_err(|_| Nack::Flash)?;
-    flash.blocking_write(from, bytes).map_err(|_| Nack::Flash)?;
-    critical_section::with(|cs| controller::PENDING.borrow_ref_mut(cs).replace((lp, img.control)));
-    info!("new configuration: model {}, written to flash", img.model_id());
-    Ok(())
+    let (lp, cfg) = runnable(&img).map_err(|_| Nack::InvalidPage)?;
+    let (slot, seq) = slots::commit_target(running);
+    let image = slots::slot_image(bytes, seq).ok_or(Nack::InvalidPage)?;
+    flash::program_slot(slot, &image).await.map_err(|e| {
+        error!("configuration commit to slot {}: {}", slot, e);
+        Nack::Flash
+    })?;
+    match inspect(slot) {
+        (SlotState::Valid(s), _) if s == seq => {}
+        (state, _) => {
+            error!("configuration slot {} reads back as {}", slot, state);
+            return Err(Nack::Flash);
+        }
+    }
+    critical_section::with(|cs| controller::PENDING.borrow_ref_mut(cs).replace((lp, cfg)));
+    // A board held by a damaged configuration runs again once a good page is committed.
+    if DAMAGED.swap(false, Ordering::Relaxed) {
+        controller::RESET.store(true, Ordering::Relaxed);
+    }
+    CONFIG_SOURCE.store(source_code(Some((slot, seq)), false), Ordering::Relaxed);
+    info!("new configuration: model {}, slot {} commit {}", img.model_id(), slot, seq);
+    Ok((slot, seq))
 }

@@ -2,8 +2,15 @@
 //! started by TIM1's TRGO2 once per PWM period) runs `model_core::control::ControlStep::step`
 //! on every sample and writes the bridge. The slow supervisor pass
 //! (`ControlStep::slow`: configuration fingerprint, time step, temperature compensation)
-//! runs at [`SLOW_HZ`] from the `supervisor` task ([`slow_pass`]). Everything else talks to
-//! the interrupt through the atomics and the critical-section cells here.
+//! runs in the same interrupt, after the compare write, on the first sample after the
+//! `supervisor` task asks for it ([`SLOW_HZ`], [`request_slow_pass`]): thread mode never
+//! masks interrupts around it, and the compare write is never delayed by it.
+//!
+//! TIM1's update interrupt, one priority level above, is the deadline monitor: at every
+//! period start it checks that the previous period's step finished; a late or stuck
+//! control interrupt puts the bridge in its safe state within one PWM period and latches
+//! the stall ([`firmware::bridge`]). Everything else talks to the interrupts through the
+//! atomics and the critical-section cells here.
 
 use core::cell::{Cell, RefCell};
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -13,13 +20,13 @@ use embassy_stm32::adc::InjectedAdc;
 use embassy_stm32::interrupt;
 use embassy_stm32::peripherals::{ADC1, TIM1};
 use embassy_stm32::timer::complementary_pwm::ComplementaryPwm;
-use embassy_stm32::timer::Channel;
 use model_core::control::{
-    ConfigImage, ControlConfig, ControlInput, ControlOutput, ControlState, ControlStep, LoopMode, PageError, RateSpec,
-    ValidatedConfig,
+    ConfigImage, ControlInput, ControlOutput, ControlState, ControlStep, PageError, ValidatedConfig,
 };
 use model_core::models::{algebraic, bouc_wen, lugre, tanh};
 use model_core::Model;
+
+use firmware::bridge::{self, Bridge};
 
 use crate::board;
 
@@ -76,23 +83,16 @@ impl Loop {
     }
 }
 
-/// The compiled-in configuration, used when the flash page is blank or invalid: the
-/// algebraic model (seed 000 eq. 14) in T with a placeholder set, torque mode, the 20 kHz
-/// defaults of `ControlConfig`. The bridge stays off until a command enables it; load the
-/// clutch's fitted set with `hil-sim export` (README).
-pub fn default_image() -> Result<ConfigImage, PageError> {
-    let dt = 1.0 / board::CONTROL_HZ as f32;
-    let control = ControlConfig { mode: LoopMode::Torque, ..ControlConfig::defaults(dt) }
-        .validate()
-        .map_err(PageError::Invalid)?;
-    ConfigImage::new(algebraic::Algebraic::ID, &[20.0, -0.05, -10.0, 0.8], RateSpec::Filtered { fc: 150.0 }, control)
-}
+/// The compiled-in configuration ([`firmware::bringup::default_image`]).
+pub use firmware::bringup::default_image;
 
 /// What the interrupt owns.
 pub struct Control {
     pub lp: Loop,
     pub cfg: ValidatedConfig,
-    pub pwm: ComplementaryPwm<'static, TIM1>,
+    /// Owns TIM1 and its pins (the interrupt writes the compares and MOE by register,
+    /// `board::set_compares`).
+    pub _pwm: ComplementaryPwm<'static, TIM1>,
     pub adc: InjectedAdc<'static, ADC1, 3>,
     /// Timer compare value for duty 1.
     pub max_duty: u32,
@@ -100,7 +100,7 @@ pub struct Control {
     pub period_cycles: u32,
     /// The previous step missed its deadline.
     pub overrun: bool,
-    pub driving: bool,
+    pub bridge: Bridge,
 }
 
 pub static CONTROL: Mutex<RefCell<Option<Control>>> = Mutex::new(RefCell::new(None));
@@ -114,6 +114,14 @@ pub static RESET: AtomicBool = AtomicBool::new(false);
 /// Samples processed and overruns since start-up.
 pub static SAMPLES: AtomicU32 = AtomicU32::new(0);
 pub static OVERRUNS: AtomicU32 = AtomicU32::new(0);
+/// The control interrupt stopped (deadline monitor or watchdog task), or no usable
+/// configuration: the bridge stays off and the step is told of an overrun (so it latches
+/// the `Overrun` fault when enabled) until a reset command.
+pub static STALLED: AtomicBool = AtomicBool::new(false);
+/// A slow pass is due (set by the supervisor task, taken by the control interrupt).
+static SLOW_DUE: AtomicBool = AtomicBool::new(false);
+/// SAMPLES at the previous period start (deadline monitor).
+static LAST_SEEN: AtomicU32 = AtomicU32::new(0);
 
 /// One decimated sample for telemetry (raw output of the step; formatting and unit
 /// scaling happen in the telemetry task).
@@ -152,57 +160,71 @@ pub const SLOW_HZ: u64 = 1_000;
 /// Slow passes run (telemetry).
 pub static SLOW_PASSES: AtomicU32 = AtomicU32::new(0);
 
-/// One slow supervisor pass over the running controller (a short critical section: the
-/// fingerprint of the configuration, a few hundred instructions). The board has no
-/// temperature sensor: NaN (no compensation).
-pub fn slow_pass() {
-    critical_section::with(|cs| {
-        if let Some(c) = CONTROL.borrow_ref_mut(cs).as_mut() {
-            c.lp.slow(&c.cfg, f32::NAN);
-        }
-    });
-    SLOW_PASSES.fetch_add(1, Ordering::Relaxed);
+/// Ask for one slow supervisor pass; the control interrupt runs it after its next
+/// compare write.
+pub fn request_slow_pass() {
+    SLOW_DUE.store(true, Ordering::Relaxed);
 }
 
-/// The bridge's safe state: main output enable off, so every switch takes its idle state
-/// (off; OSSI set at start-up) and the coil current decays through the body diodes. A
-/// register write through the PAC so that the panic and fault handlers can call it
-/// whatever the rest of the program holds.
+/// The bridge's safe state ([`board::safe_state`]).
 #[inline(always)]
 pub fn safe_state() {
-    embassy_stm32::pac::TIM1.bdtr().modify(|w| w.set_moe(false));
+    board::safe_state();
 }
 
-/// Sign-magnitude drive: positive duty switches half-bridge A with |d| and holds B's low
-/// side on, negative the other way round.
-fn drive(c: &mut Control, out: &ControlOutput) {
-    if !out.pwm_enable {
+/// Write the bridge for one step's output: compares first, MOE a period later
+/// ([`firmware::bridge`]); never while the stall is latched.
+#[inline(always)]
+fn drive(c: &mut Control, out: &ControlOutput, stalled: bool) {
+    let (next, action) = c.bridge.next(out.pwm_enable && !stalled);
+    c.bridge = next;
+    match action {
+        bridge::Action::Off => safe_state(),
+        bridge::Action::Arm | bridge::Action::Drive => {
+            let (a, b) = bridge::compares(out.compare, c.max_duty);
+            board::set_compares(a, b);
+            if action == bridge::Action::Drive {
+                board::moe_on();
+            }
+        }
+    }
+}
+
+/// The deadline monitor: TIM1's update interrupt at every PWM period start, above the
+/// control interrupt's priority. The step of the previous period must have finished.
+#[interrupt]
+fn TIM1_UP_TIM16() {
+    board::clear_update_flag();
+    let now = SAMPLES.load(Ordering::Relaxed);
+    let last = LAST_SEEN.swap(now, Ordering::Relaxed);
+    if now == last && RUNNING.load(Ordering::Relaxed) {
         safe_state();
-        c.driving = false;
-        return;
-    }
-    let mag = out.compare.unsigned_abs().min(c.max_duty);
-    let (a, b) = if out.compare >= 0 { (mag, 0) } else { (0, mag) };
-    c.pwm.set_duty(Channel::Ch1, a);
-    c.pwm.set_duty(Channel::Ch2, b);
-    if !c.driving {
-        c.pwm.set_master_output_enable(true);
-        c.driving = true;
+        STALLED.store(true, Ordering::Relaxed);
     }
 }
 
+/// The control interrupt has run at least once (the monitor starts then).
+pub static RUNNING: AtomicBool = AtomicBool::new(false);
+
+/// The control interrupt. It masks nothing (no `cpsid`): the deadline monitor above it
+/// must be able to pre-empt a step that does not finish.
 #[interrupt]
 fn ADC1_2() {
     let t0 = cortex_m::peripheral::DWT::cycle_count();
-    critical_section::with(|cs| {
+    // SAFETY: a critical-section token without masking interrupts. Thread mode touches
+    // CONTROL only before this interrupt is enabled, and PENDING/TELEMETRY only inside
+    // real critical sections (PRIMASK), which this interrupt cannot pre-empt; the only
+    // handler above this one (TIM1_UP_TIM16) touches none of the cells.
+    let cs = unsafe { critical_section::CriticalSection::new() };
+    {
         let mut ctl = CONTROL.borrow_ref_mut(cs);
         let Some(c) = ctl.as_mut() else {
             safe_state();
             return;
         };
         let [hall, current, supply] = c.adc.read_injected_samples();
-        let supply_v = f32::from(supply) * (board::VREF / 4095.0 * board::SUPPLY_DIVIDER);
-        if !c.driving {
+        let supply_v = firmware::bringup::supply_volts(supply);
+        if c.bridge == Bridge::Off {
             // Swap in a new configuration only while the bridge is off.
             if let Some((lp, cfg)) = PENDING.borrow_ref_mut(cs).take() {
                 c.lp = lp;
@@ -210,15 +232,24 @@ fn ADC1_2() {
             }
         }
         let reference = f32::from_bits(REFERENCE.load(Ordering::Relaxed));
+        let reset = RESET.swap(false, Ordering::Relaxed);
+        if reset {
+            STALLED.store(false, Ordering::Relaxed);
+        }
+        let stalled = STALLED.load(Ordering::Relaxed);
+        // A latched stall is an overrun for the step (it trips `Overrun` after
+        // `confirm_samples` if enabled, so the mode reads a fault, not Running) and the
+        // bridge stays off meanwhile.
         let input = ControlInput {
-            overrun: c.overrun,
+            overrun: c.overrun || stalled,
             enable: ENABLE.load(Ordering::Relaxed),
-            reset: RESET.swap(false, Ordering::Relaxed),
+            reset,
             ..ControlInput::new(hall, current, supply_v, reference)
         };
         let out = c.lp.step(&c.cfg, input);
-        drive(c, &out);
+        drive(c, &out, stalled);
         let n = SAMPLES.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
+        RUNNING.store(true, Ordering::Relaxed);
         let cycles = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
         c.overrun = cycles > c.period_cycles;
         if c.overrun {
@@ -227,5 +258,11 @@ fn ADC1_2() {
         if n.is_multiple_of(TELEMETRY_DECIMATION) {
             TELEMETRY.borrow(cs).set(Snapshot { out, reference, supply_v, cycles });
         }
-    });
+        // The slow pass after the compare write (the board has no temperature sensor:
+        // NaN, no compensation).
+        if SLOW_DUE.swap(false, Ordering::Relaxed) {
+            c.lp.slow(&c.cfg, f32::NAN);
+            SLOW_PASSES.fetch_add(1, Ordering::Relaxed);
+        }
+    }
 }

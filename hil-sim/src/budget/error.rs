@@ -38,6 +38,8 @@ pub enum BudgetError {
     BenchFailed { status: String, stdout: String, stderr: String },
     #[error("QEMU's log pipe")]
     NoLogPipe,
+    #[error("the firmware ELF has no symbol `{0}`")]
+    NoSymbol(String),
     #[error("the traced bench run failed on QEMU ({status})")]
     TracedRunFailed { status: String },
     #[error("the trace ended inside a measured call")]

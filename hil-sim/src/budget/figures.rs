@@ -6,6 +6,7 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
+use super::isr::{tree, Interrupts};
 use super::table::{Budget, CONTROL_HZ, CORE_HZ};
 
 /// Figures of one measured step.
@@ -58,17 +59,42 @@ pub struct Report {
     pub steps: Vec<StepFigures>,
     /// Instructions in the whole trace (bench set-up included).
     pub traced_instructions: u64,
+    /// The shipping firmware's interrupts (static, from its ELF).
+    pub interrupts: Option<Interrupts>,
 }
 
 impl Report {
-    /// Steps that miss their budget, with the reasons.
+    /// Steps that miss their budget, with the reasons; and f64 soft-float reachable from a
+    /// firmware interrupt.
     pub fn exceeded(&self) -> Vec<String> {
-        self.named(StepFigures::excess)
+        let mut v = self.named(StepFigures::excess);
+        if let Some(i) = &self.interrupts {
+            v.extend(i.warnings());
+        }
+        v
     }
 
-    /// Steps over the ceiling `--check` enforces, with the reasons.
+    /// Steps over the ceiling `--check` enforces, with the reasons; and what the firmware's
+    /// interrupts may not do (mask interrupts, step + slow pass beyond a period).
     pub fn over_ceiling(&self) -> Vec<String> {
-        self.named(StepFigures::over_ceiling)
+        let mut v = self.named(StepFigures::over_ceiling);
+        if let Some(i) = &self.interrupts {
+            v.extend(i.violations());
+        }
+        if let Some(c) = self.isr_cycles_max() {
+            let period = (CORE_HZ / CONTROL_HZ) as u64;
+            if c > period {
+                v.push(format!("control interrupt with the slow pass: {c} cycles > one period ({period})"));
+            }
+        }
+        v
+    }
+
+    /// Worst cycles of the control interrupt on a sample that also runs the slow pass:
+    /// `control_step` + `supervisor_slow` (upper bounds).
+    pub fn isr_cycles_max(&self) -> Option<u64> {
+        let get = |n: &str| self.steps.iter().find(|s| s.name == n && !s.outside).map(|s| s.cycles_max);
+        Some(get("control_step")? + get("supervisor_slow")?)
     }
 
     fn named(&self, reasons: impl Fn(&StepFigures) -> Vec<String>) -> Vec<String> {
@@ -129,5 +155,39 @@ pub fn table(r: &Report) -> String {
             s += &row(st);
         }
     }
+    if let Some(i) = &r.interrupts {
+        s += &interrupts(r, i);
+    }
+    s
+}
+
+/// The interrupt section of the table: call graphs, f64 helpers, masking.
+fn interrupts(r: &Report, i: &Interrupts) -> String {
+    let mut s = String::from("\nfirmware interrupts as built (static call graph of the shipping ELF)\n");
+    for root in &i.roots {
+        s += &format!(
+            "{}: {} functions, f64 soft-float helpers: {}, masks interrupts: {}\n",
+            root.name,
+            root.call_graph.len(),
+            if root.f64_soft_float.is_empty() { "none".to_owned() } else { root.f64_soft_float.join(", ") },
+            if root.masking.is_empty() { "no".to_owned() } else { root.masking.join(", ") },
+        );
+        s += &tree(root);
+    }
+    if let Some(c) = r.isr_cycles_max() {
+        s += &format!(
+            "control interrupt with the slow pass in its tail: <= {c} cycles of {} a period; \
+             slow pass masked stretch: 0 cycles (it runs in the interrupt, which masks nothing)\n",
+            (CORE_HZ / CONTROL_HZ) as u64
+        );
+    }
+    let m = &i.thread_masked;
+    s += &format!(
+        "longest interrupt-masked stretch in thread mode: {} instructions, <= {} cycles ({}{})\n",
+        m.instructions,
+        m.cycles_max,
+        m.function,
+        if m.calls.is_empty() { String::new() } else { format!("; calls {}", m.calls.join(", ")) }
+    );
     s
 }

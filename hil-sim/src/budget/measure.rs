@@ -6,7 +6,7 @@ use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
 use std::process::Stdio;
 
-use super::bench_build::{build_bench, workspace_root};
+use super::bench_build::{build_bench, firmware_elf, workspace_root};
 use super::error::BudgetError;
 use super::figures::Report;
 use super::tools::{disassemble, Tools};
@@ -73,22 +73,28 @@ pub fn measure(tools: &Tools, elf: &Path) -> Result<Report, BudgetError> {
         machine: "qemu-system-arm -M mps2-an386 -cpu cortex-m4 (Cortex-M4F)",
         steps,
         traced_instructions: executed,
+        interrupts: None,
     })
 }
 
-/// The whole `hil-sim budget`: find the tools, build the bench unless `elf` names a
-/// prebuilt one, and measure it; what it is doing goes to `progress` as messages.
+/// The whole `hil-sim budget`: find the tools, build the bench and the firmware unless
+/// `elf` names a prebuilt bench (the firmware ELF is then expected beside it), measure the
+/// bench and read the firmware's interrupts; what it is doing goes to `progress`.
 pub fn run(elf: Option<&Path>, progress: &dyn Progress) -> Result<Report, BudgetError> {
     let tools = Tools::find()?;
     let elf = match elf {
         Some(p) => p.to_path_buf(),
         None => {
             progress.message(
-                "building the bench (cargo build --release -p firmware --target thumbv7em-none-eabihf --bin budget)",
+                "building the bench and the firmware (cargo build --release -p firmware --target thumbv7em-none-eabihf)",
             );
             build_bench(&workspace_root())?
         }
     };
     progress.message(&format!("tracing {} on QEMU mps2-an386 (a minute or two)", elf.display()));
-    measure(&tools, &elf)
+    let mut report = measure(&tools, &elf)?;
+    let firmware = firmware_elf(&elf);
+    progress.message(&format!("reading the interrupts of {}", firmware.display()));
+    report.interrupts = Some(super::isr::analyse(&tools.objdump, &firmware)?);
+    Ok(report)
 }

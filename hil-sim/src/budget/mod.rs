@@ -25,24 +25,34 @@
 //! [`BUDGETS`] is the one table of targets; `hil-sim budget --check` fails naming the step
 //! that exceeds one.
 //!
+//! The shipping firmware ELF, built beside the bench, is read statically ([`isr`]): the
+//! control interrupt's call graph as built (f64 soft-float helpers reachable from it are
+//! reported; it may not mask interrupts: the deadline monitor must pre-empt it), and the longest
+//! interrupt-masked stretch left in thread mode. The slow supervisor pass runs in the
+//! control interrupt's tail (after the compare write), so the interrupt's worst case is
+//! `control_step` + `supervisor_slow`, checked against one control period.
+//!
 //! Modules: [`table`](mod@table) (the targets), [`cycles`] (instruction classes),
 //! [`trace`] (bench output and QEMU log), [`figures`] (per-step figures, the report and its
 //! table), [`tools`] (QEMU, llvm-objdump), [`bench_build`] (cargo build of the bench),
-//! [`measure`](mod@measure) (the runs on QEMU), [`error`] (why a measurement failed).
+//! [`measure`](mod@measure) (the runs on QEMU), [`isr`] (the firmware's interrupts as
+//! built), [`error`] (why a measurement failed).
 
 pub mod bench_build;
 pub mod cycles;
 pub mod error;
 pub mod figures;
+pub mod isr;
 pub mod measure;
 pub mod table;
 pub mod tools;
 pub mod trace;
 
-pub use bench_build::{build_bench, workspace_root};
+pub use bench_build::{build_bench, firmware_elf, workspace_root};
 pub use cycles::{cycles_of, parse_disassembly, Cycles};
 pub use error::BudgetError;
 pub use figures::{table, Report, StepFigures};
+pub use isr::{Interrupts, Masked, Root};
 pub use measure::{measure, run};
 pub use table::{Budget, BUDGETS, CONTROL_HZ, CORE_HZ};
 pub use tools::{disassemble, Tools};

@@ -48,8 +48,8 @@ pub const BUDGETS: [Budget; 7] = [
     // the slow-developing supervisor checks moved to the slow pass, 355 before the
     // feed-forward's linearisation moved there and the torque loop went to half rate).
     Budget::met("control_step", 300, 128),
-    // The slow supervisor pass (`ControlStep::slow`, 1 kHz from a thread-mode task, not in
-    // the interrupt): configuration fingerprint, coefficients, time step, the feed-forward's
+    // The slow supervisor pass (`ControlStep::slow`, 1 kHz, requested by a thread-mode task
+    // and run in the control interrupt's tail since 2026-11-24, issue 19): configuration fingerprint, coefficients, time step, the feed-forward's
     // linearisation, and since 2026-11-22 the slow-developing checks (Hall noise, stuck
     // Hall, coil open, B/i band) replayed over the ≤ 20 samples logged since the previous
     // pass (~85 instructions a sample; 2,847 / 344 B measured on 2026-11-23). Raised from

@@ -61,6 +61,19 @@ pub fn run(a: BudgetArgs) -> anyhow::Result<()> {
             "traced_instructions": report.traced_instructions,
             "steps": steps,
             "outside_envelope": outside,
+            "interrupts": report.interrupts.as_ref().map(|i| json!({
+                "roots": i.roots.iter().map(|r| json!({
+                    "name": r.name,
+                    "functions": r.call_graph.len(),
+                    "call_graph": r.call_graph.iter().map(|(f, c)| json!({"function": f, "calls": c})).collect::<Vec<_>>(),
+                    "f64_soft_float": r.f64_soft_float,
+                    "masking": r.masking,
+                    "indirect_calls": r.indirect_calls,
+                })).collect::<Vec<_>>(),
+                "isr_with_slow_pass_cycles_max": report.isr_cycles_max(),
+                "slow_pass_masked_cycles": 0,
+                "thread_masked": i.thread_masked,
+            })),
         }))?;
     } else {
         super::emit(&budget::table(&report));
