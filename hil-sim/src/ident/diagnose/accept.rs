@@ -1,7 +1,8 @@
 //! Stage 4 of a diagnosis, modelling: in the round's ranking, the first candidate that
 //! lowers the training error, gains on the information criterion, passes the held-out
-//! block test ([`super::significance`]) and changes the prediction by more than the
-//! residual's noise floor resolves is kept; every candidate is recorded as tested.
+//! block test ([`super::significance`]), changes the prediction by more than the
+//! residual's noise floor resolves and is physically possible ([`super::physical`]) is
+//! kept; every candidate is recorded as tested.
 
 use super::augment::Fitted;
 use super::candidates::Candidate;
@@ -55,7 +56,9 @@ impl Judge<'_> {
                 / self.rows.len().max(1) as f64)
                 .sqrt();
             let resolvable = change >= significance::MIN_TERM_OF_NOISE * self.noise_rms;
+            let impossible = super::physical::impossible(c, f, reference.terms.len(), s.value);
             let kept = accepted.is_none()
+                && impossible.is_none()
                 && s.bic_gain > 0.0
                 && f.train_mse < reference.train_mse
                 && test.significant
@@ -70,6 +73,7 @@ impl Judge<'_> {
                 heldout_r_rmse_after: after.r_rmse,
                 test,
                 kept,
+                impossible,
             });
             if kept {
                 accepted = Some(Accepted { scored: s, test, after });

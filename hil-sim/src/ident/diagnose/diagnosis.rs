@@ -60,6 +60,9 @@ pub struct Tested {
     pub heldout_r_rmse_after: f64,
     pub test: Test,
     pub kept: bool,
+    /// Why its fitted values are physically impossible (then it is never kept).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub impossible: Option<String>,
 }
 
 /// The whole diagnosis.

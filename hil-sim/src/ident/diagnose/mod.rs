@@ -34,6 +34,7 @@ pub mod diagnosis;
 pub mod leak;
 pub mod locate;
 pub mod options;
+pub mod physical;
 pub mod profile;
 pub mod rank;
 pub mod refit;
