@@ -26,6 +26,8 @@ struct Outcome {
     case: Case,
     form: String,
     found: Vec<String>,
+    /// Round 1's candidates: effect, BIC gain, held-out R-RMSE after, t, why impossible.
+    round1: Vec<String>,
     base: String,
     seconds: f64,
 }
@@ -46,11 +48,29 @@ fn run(c: &Case) -> Outcome {
     let (rec, data) = (&prepared.recording, &prepared.data);
     let aux = rec.auxiliary_channels(&ch);
     let opts = DiagnoseOptions::default();
-    let (found, base, seconds) = match diagnose(data, aux, None, ("b", "torque"), &opts, &NoProgress) {
-        Ok(d) => (d.findings.iter().map(|f| f.effect.clone()).collect(), d.base_model, d.seconds),
-        Err(e) => (vec![format!("error: {e}")], String::new(), 0.0),
+    let (found, round1, base, seconds) = match diagnose(data, aux, None, ("b", "torque"), &opts, &NoProgress) {
+        Ok(d) => (
+            d.findings.iter().map(|f| f.effect.clone()).collect(),
+            d.candidates
+                .iter()
+                .filter(|t| t.round == 1)
+                .map(|t| {
+                    format!(
+                        "{} bic {:.0} after {:.2} % t {:.1}{}",
+                        t.effect,
+                        t.bic_gain,
+                        100.0 * t.heldout_r_rmse_after,
+                        t.test.t,
+                        t.impossible.as_deref().map(|w| format!(" ({w})")).unwrap_or_default()
+                    )
+                })
+                .collect(),
+            d.base_model,
+            d.seconds,
+        ),
+        Err(e) => (vec![format!("error: {e}")], Vec::new(), String::new(), 0.0),
     };
-    Outcome { case: c.clone(), form: g.label.form, found, base, seconds }
+    Outcome { case: c.clone(), form: g.label.form, found, round1, base, seconds }
 }
 
 fn line(o: &Outcome) -> String {
@@ -144,6 +164,9 @@ fn run_all(cases: &[Case]) -> Vec<Outcome> {
         .map(|c| {
             let o = run(c);
             println!("{}", line(&o));
+            if !o.right() && std::env::var("BENCH_VERBOSE").is_ok() {
+                println!("      round 1: {}", o.round1.join("; "));
+            }
             o
         })
         .collect()

@@ -42,11 +42,15 @@ impl Judge<'_> {
         metrics(&pick(self.y), &pick(pred), None)
     }
 
-    /// Judge the `ranked` candidates of round `round` (1-based) against `reference`.
+    /// Judge the `ranked` candidates of round `round` (1-based) against `reference`: of the
+    /// eligible ones (a training gain, significant on the held-out blocks, resolvable above
+    /// the noise, physically possible), the one with the lowest held-out error is kept — the
+    /// term that predicts data it was not fitted on best, not the one that fits the
+    /// training part best (a wrong term on a misfitting base can fit more and predict less).
     pub fn round(&self, round: usize, cands: &[Candidate], reference: &Fitted, ranked: Vec<Scored>) -> Verdict {
         let before = self.heldout(&reference.pred);
         let mut tested = Vec::with_capacity(ranked.len());
-        let mut accepted = None;
+        let mut judged = Vec::with_capacity(ranked.len());
         for s in ranked {
             let (c, f) = (&cands[s.index], &s.fitted);
             let test = significance::test(self.y, &reference.pred, &f.pred, self.held);
@@ -57,8 +61,7 @@ impl Judge<'_> {
                 .sqrt();
             let resolvable = change >= significance::MIN_TERM_OF_NOISE * self.noise_rms;
             let impossible = super::physical::impossible(c, f, reference.terms.len(), s.value);
-            let kept = accepted.is_none()
-                && impossible.is_none()
+            let eligible = impossible.is_none()
                 && s.bic_gain > 0.0
                 && f.train_mse < reference.train_mse
                 && test.significant
@@ -72,13 +75,17 @@ impl Judge<'_> {
                 heldout_r_rmse_before: before.r_rmse,
                 heldout_r_rmse_after: after.r_rmse,
                 test,
-                kept,
+                kept: false,
                 impossible,
             });
-            if kept {
-                accepted = Some(Accepted { scored: s, test, after });
-            }
+            judged.push((eligible, s, test, after));
         }
+        let best = (0..judged.len()).filter(|&k| judged[k].0).min_by(|&a, &b| judged[a].3.rmse.total_cmp(&judged[b].3.rmse));
+        let accepted = best.map(|k| {
+            tested[k].kept = true;
+            let (_, s, test, after) = judged.swap_remove(k);
+            Accepted { scored: s, test, after }
+        });
         Verdict { before, tested, accepted }
     }
 }

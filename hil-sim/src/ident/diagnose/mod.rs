@@ -113,10 +113,18 @@ pub fn diagnose(
         let (lo, hi) = held.iter().fold((f64::MAX, f64::MIN), |(l, h), &i| (l.min(y[i]), h.max(y[i])));
         (hi - lo).max(1e-300)
     };
+    let mut notes = base.failed.clone();
     for round in 0..opts.max_findings {
         progress.message(&format!("round {}: naming", round + 1));
         let reference = rank::reference(&prob, &current).ok_or_else(diverges)?;
-        let Some(ranked) = rank::rank(&prob, &cands, &reference, &used) else { break };
+        let Some(ranked) = rank::rank(&prob, &cands, &reference, &used) else {
+            notes.push(format!(
+                "round {}: the base model {id}'s Jacobian could not be taken at its fitted parameters (its \
+                 replay diverges when a parameter is nudged), so no further candidate was tested",
+                round + 1
+            ));
+            break;
+        };
         progress.advance(1);
         progress.message(&format!("round {}: testing", round + 1));
         let verdict = judge.round(round + 1, &cands, &reference, ranked);
@@ -124,6 +132,7 @@ pub fn diagnose(
         progress.advance(1);
         let Some(kept) = verdict.accepted else { break };
         let c = &cands[kept.scored.index];
+        let runner_up = describe::runner_up(&tested, round + 1, c.effect, &kept.test, kept.after.r_rmse);
         findings.push(describe::finding(&Described {
             data,
             candidate: c,
@@ -139,6 +148,8 @@ pub fn diagnose(
             rate: &dx,
             aux: &aux_refs,
             rows: &all_rows,
+            boundaries: &opts.boundaries,
+            runner_up,
         }));
         used.push(kept.scored.index);
         // A candidate of the same effect on the same channel is not tested again.
@@ -160,6 +171,8 @@ pub fn diagnose(
         locate: located,
         channels,
         candidates: tested,
+        notes,
+        units: (unit_of(names.0).unwrap_or("").to_owned(), unit_of(names.1).unwrap_or("").to_owned()),
         seconds: started.elapsed().as_secs_f64(),
         plot: PlotData {
             time: data.time.clone(),

@@ -7,7 +7,7 @@
 //! | `field_lag` | first-order lag `τ·ḃ_f = b − b_f`; two poles `τ/2` each; an eddy share `0.3·b + 0.7·b_f` |
 //! | `transport_delay` | the torque responds `d` late (`b(t − d)`); the Hall channel is logged `d` late (fractional, cubic interpolation) |
 //! | `saturation` | of the field `b_s·tanh(b/b_s)`; of the field, sharper knee `b/(1 + (b/b_s)⁴)^¼`; of the yield stress `T_lo + u/√(1 + (u/S)²)` |
-//! | `rate_dependence` | `c·|ḃ|·ḃ`; damping rising with frequency `c·(ḃ − ḃ_lowpass(4 Hz))`; `c·ḃ³` |
+//! | `rate_dependence` | `c·|ḃ|·ḃ`; a damping coefficient growing with the local excitation frequency `c·f_loc(t)·ḃ`; `c·ḃ³` |
 //! | `asymmetry` | `δ·(b − b̄)·tanh(ḃ/ε)`; loading branch only `δ·(b − b_min)·(1 + tanh(ḃ/ε))/2`; quadratic `δ·(b − b̄)²·tanh(ḃ/ε)` |
 //! | `thermal_drift` | the heating state `θ` (driven by the slip power `|T·ω|`) scales the torque `T·(1 − κ·θ)`; shifts it `−κ·θ` (off-state drift); lowers the yield part `−κ·θ·(T − T_lo)` |
 //! | `slip_speed` | `c_ω·ω`; `c_ω·ω·b/b_max`; `c_ω·√ω` |
@@ -161,8 +161,18 @@ fn term_shape(w: &World, effect: &str, form: usize) -> (Vec<f64>, &'static str, 
     match (effect, form) {
         ("rate_dependence", 0) => (db.iter().map(|d| d.abs() * d).collect(), "c_nm_s2_per_t2", "|rate|·rate"),
         ("rate_dependence", 1) => {
-            let slow = first_order(db, 1.0 / (2.0 * std::f64::consts::PI * 4.0), dt);
-            (db.iter().zip(slow).map(|(d, s)| d - s).collect(), "c_nm_s_per_t", "damping rising with frequency")
+            // The local excitation frequency: RMS rate over 2π·RMS level about the local
+            // mean, both over the last second (a first-order average, τ = 0.5 s).
+            let level = first_order(b, 0.5, dt);
+            let dev2: Vec<f64> = b.iter().zip(&level).map(|(b, m)| (b - m).powi(2)).collect();
+            let rate2: Vec<f64> = db.iter().map(|d| d * d).collect();
+            let (dev2, rate2) = (first_order(&dev2, 0.5, dt), first_order(&rate2, 0.5, dt));
+            let f: Vec<f64> = dev2
+                .iter()
+                .zip(&rate2)
+                .map(|(v, r)| (r.sqrt() / (2.0 * std::f64::consts::PI * v.sqrt().max(1e-6))).min(30.0))
+                .collect();
+            (db.iter().zip(&f).map(|(d, f)| d * f).collect(), "c_nm_s2_per_t", "damping growing with the frequency")
         }
         ("rate_dependence", _) => (db.iter().map(|d| d * d * d).collect(), "c_nm_s3_per_t3", "rate cubed"),
         ("asymmetry", 0) => (
