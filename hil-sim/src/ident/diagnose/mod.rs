@@ -108,11 +108,7 @@ pub fn diagnose(
     let mut findings = Vec::new();
     let mut tested = Vec::new();
     let mut used: Vec<usize> = Vec::new();
-    let y_span = {
-        let y = &data.output;
-        let (lo, hi) = held.iter().fold((f64::MAX, f64::MIN), |(l, h), &i| (l.min(y[i]), h.max(y[i])));
-        (hi - lo).max(1e-300)
-    };
+    let y_span = span_on(&data.output, &held);
     let mut notes = base.failed.clone();
     for round in 0..opts.max_findings {
         progress.message(&format!("round {}: naming", round + 1));
@@ -153,11 +149,7 @@ pub fn diagnose(
         }));
         used.push(kept.scored.index);
         // A candidate of the same effect on the same channel is not tested again.
-        for (j, o) in cands.iter().enumerate() {
-            if o.effect == c.effect && o.channel == c.channel {
-                used.push(j);
-            }
-        }
+        used.extend((0..cands.len()).filter(|&j| cands[j].effect == c.effect && cands[j].channel == c.channel));
         current = kept.scored.fitted;
     }
     let unchanged = current.transforms.is_empty() && current.terms.is_empty();
@@ -185,6 +177,12 @@ pub fn diagnose(
             fs: 1.0 / data.dt,
         },
     })
+}
+
+/// Peak-to-peak of `y` over `rows`.
+fn span_on(y: &[f64], rows: &[usize]) -> f64 {
+    let (lo, hi) = rows.iter().fold((f64::MAX, f64::MIN), |(l, h), &i| (l.min(y[i]), h.max(y[i])));
+    (hi - lo).max(1e-300)
 }
 
 /// Keep `Transform` in the public surface for the report.

@@ -47,7 +47,7 @@ pub const AMBIENT_C: f64 = 25.0;
 /// Sampling rates drawn, Hz.
 pub const RATES_HZ: &[f64] = &[500.0, 1000.0, 2000.0, 5000.0, 10_000.0];
 /// Most samples of one recording (the duration shrinks at the high rates).
-pub const MAX_SAMPLES: f64 = 60_000.0;
+pub const MAX_SAMPLES: f64 = 40_000.0;
 
 /// Which half of the seeds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
