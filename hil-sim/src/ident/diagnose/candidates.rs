@@ -241,11 +241,15 @@ fn additive(
     }
 }
 
-/// Every candidate for this recording.
-pub fn all(data: &Dataset, aux: &[AuxChannel]) -> Vec<Candidate> {
+/// Every candidate for this recording; `input_is_field`: the input is a magnetic field
+/// (unit T), which has no mass, so `m·ẍ` of it is no inertia (a clutch's inertia shows
+/// through a speed channel).
+pub fn all(data: &Dataset, aux: &[AuxChannel], input_is_field: bool) -> Vec<Candidate> {
     let s = InputStats::of(data);
     let mut out = input_transforms(&s);
-    out.extend(kinematic_terms(&s, aux));
+    out.extend(kinematic_terms(&s, aux).into_iter().filter(|c| {
+        !(input_is_field && c.effect == "inertia" && c.channel.is_none())
+    }));
     out.extend(thermal(data, &s, aux));
     for c in aux.iter().filter(|a| a.role == Role::Speed) {
         out.extend(speed(&s, c));

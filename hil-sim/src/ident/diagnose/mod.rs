@@ -100,7 +100,7 @@ pub fn diagnose(
     progress.advance(1);
 
     // 3–4. Name and model, round by round.
-    let cands = candidates::all(data, &channels);
+    let cands = candidates::all(data, &channels, unit_of(names.0) == Some("T"));
     // The base as the refits see it: Gauss–Newton run on from the fit until it stalls, so
     // that a term is never credited with what more iterations of the base would have done.
     let diverges = || DiagnoseError::Diverges(id.clone());
