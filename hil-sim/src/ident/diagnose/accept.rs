@@ -80,7 +80,8 @@ impl Judge<'_> {
             });
             judged.push((eligible, s, test, after));
         }
-        let best = (0..judged.len()).filter(|&k| judged[k].0).min_by(|&a, &b| judged[a].3.rmse.total_cmp(&judged[b].3.rmse));
+        let best =
+            (0..judged.len()).filter(|&k| judged[k].0).min_by(|&a, &b| judged[a].3.rmse.total_cmp(&judged[b].3.rmse));
         let accepted = best.map(|k| {
             tested[k].kept = true;
             let (_, s, test, after) = judged.swap_remove(k);

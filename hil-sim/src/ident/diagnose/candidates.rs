@@ -247,9 +247,11 @@ fn additive(
 pub fn all(data: &Dataset, aux: &[AuxChannel], input_is_field: bool) -> Vec<Candidate> {
     let s = InputStats::of(data);
     let mut out = input_transforms(&s);
-    out.extend(kinematic_terms(&s, aux).into_iter().filter(|c| {
-        !(input_is_field && c.effect == "inertia" && c.channel.is_none())
-    }));
+    out.extend(
+        kinematic_terms(&s, aux)
+            .into_iter()
+            .filter(|c| !(input_is_field && c.effect == "inertia" && c.channel.is_none())),
+    );
     out.extend(thermal(data, &s, aux));
     for c in aux.iter().filter(|a| a.role == Role::Speed) {
         out.extend(speed(&s, c));
@@ -282,7 +284,10 @@ fn input_transforms(s: &InputStats) -> Vec<Candidate> {
             effect: "transport_delay",
             label: "time shift between input and output".into(),
             grid_name: Some("delay_s".into()),
-            grid: (-(max_delay as i64)..=max_delay as i64).filter(|k| *k != 0).map(|k| k as f64 * stride * dt).collect(),
+            grid: (-(max_delay as i64)..=max_delay as i64)
+                .filter(|k| *k != 0)
+                .map(|k| k as f64 * stride * dt)
+                .collect(),
             build: Box::new(|d| Piece { transform: Some(Transform::Delay { delay_s: d }), terms: vec![] }),
             channel: None,
         },

@@ -64,9 +64,7 @@ fn caveats(data: &Dataset, windows: &[(f64, f64)], boundaries: &[usize]) -> Stri
         .filter(|&&t| windows.iter().any(|&(a, b)| near(a, b, t)))
         .map(|t| format!("{t:.2} s"))
         .collect();
-    let flagged = windows.iter().any(|&(a, b)| {
-        data.time.iter().zip(&data.excluded).any(|(&t, &x)| x && near(a, b, t))
-    });
+    let flagged = windows.iter().any(|&(a, b)| data.time.iter().zip(&data.excluded).any(|(&t, &x)| x && near(a, b, t)));
     let mut out = String::new();
     if !on_boundary.is_empty() {
         out += &format!(
@@ -111,9 +109,14 @@ pub fn finding(d: &Described<'_>) -> Finding {
     }
     params.insert("term_rms".into(), term_rms);
     units.insert("term_rms".into(), yu.to_owned());
-    let size =
-        format!("it changes the {} by {} RMS ({:.1} % of its span)", d.names.1, with_unit(term_rms, &unit_or(d.names.1)), 100.0 * share);
-    let weak = d.runner_up.as_ref().map(|r| format!("; the evidence is weak: the runner-up is {r}")).unwrap_or_default();
+    let size = format!(
+        "it changes the {} by {} RMS ({:.1} % of its span)",
+        d.names.1,
+        with_unit(term_rms, &unit_or(d.names.1)),
+        100.0 * share
+    );
+    let weak =
+        d.runner_up.as_ref().map(|r| format!("; the evidence is weak: the runner-up is {r}")).unwrap_or_default();
     let summary = format!(
         "{}; {size}; held-out R-RMSE {:.2} % -> {:.2} % ({:.0} % lower){weak}{}",
         what(d),

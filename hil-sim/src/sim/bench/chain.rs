@@ -30,8 +30,13 @@ pub fn record(w: &World, a: &Applied, c: &Case, rng: &mut impl Rng) -> Recording
     let b_rec = butter2_zero_phase(&b_adc, fc, dt);
     let t_rec = butter2_zero_phase(&t_adc, fc, dt);
     let column = |name: &str, v: &[f64]| Column { name: name.to_owned(), values: v.to_vec() };
-    let mut columns =
-        vec![column("t", &w.t), column("b", &b_rec), column("torque", &t_rec), column("i", &i_adc), column("speed", &speed)];
+    let mut columns = vec![
+        column("t", &w.t),
+        column("b", &b_rec),
+        column("torque", &t_rec),
+        column("i", &i_adc),
+        column("speed", &speed),
+    ];
     if c.temperature_channel {
         let temp: Vec<f64> = w.temperature.iter().map(|v| v + 0.05 * gauss(rng)).collect();
         columns.push(column("temperature", &temp));

@@ -88,7 +88,7 @@ impl Case {
     /// The case for `effect`, `family` and `excitation` whose other choices are drawn from
     /// `seed`.
     pub fn draw(effect: &str, family: &str, excitation: &str, seed: u64) -> Self {
-        let mut rng = rand::rngs::StdRng::seed_from_u64(seed ^ 0x5eed_0f_be4c);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed ^ 0x005e_ed0f_be4c);
         let fs_hz = RATES_HZ[rng.random_range(0..RATES_HZ.len())];
         let duration_s = (MAX_SAMPLES / fs_hz).min(30.0).floor();
         Self {

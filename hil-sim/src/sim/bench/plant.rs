@@ -86,14 +86,15 @@ mod tests {
     #[test]
     fn every_family_gives_a_clutch_like_loop() {
         let dt = 1e-3;
-        let b: Vec<f64> = (0..4000).map(|k| 0.325 + 0.275 * (2.0 * std::f64::consts::PI * 2.0 * k as f64 * dt).sin()).collect();
+        let b: Vec<f64> =
+            (0..4000).map(|k| 0.325 + 0.275 * (2.0 * std::f64::consts::PI * 2.0 * k as f64 * dt).sin()).collect();
         let db = super::super::signals::derivative(&b, dt);
         for f in FAMILIES {
             let t = torque(f, &b, &db, dt).unwrap();
             let (lo, hi) = t.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
             assert!((2.0..40.0).contains(&(hi - lo)), "{f}: span {}", hi - lo);
             // A loop: at the same field going up and coming down the torque differs.
-            let (up, down) = (t[2000 + 0], t[2000 + 250]);
+            let (up, down) = (t[2000], t[2250]);
             assert!((b[2000] - b[2250]).abs() < 1e-9 && (up - down).abs() > 0.05, "{f}: {up} {down}");
         }
         assert!(torque("x", &b, &db, dt).is_none());

@@ -40,7 +40,9 @@ pub fn excitation(name: &str, t: &[f64], dur: f64, dt: f64, rng: &mut impl Rng) 
             // Phase of the up-sweep at time s of its half; the down-sweep mirrors it.
             let phase = |s: f64| 2.0 * PI * f0 * half / k.ln() * (k.powf(s / half) - 1.0);
             let top = phase(half);
-            t.iter().map(|t| if *t <= half { phase(*t).sin() } else { (2.0 * top - phase(2.0 * half - t)).sin() }).collect()
+            t.iter()
+                .map(|t| if *t <= half { phase(*t).sin() } else { (2.0 * top - phase(2.0 * half - t)).sin() })
+                .collect()
         }
         "blocks" => {
             let mut out = Vec::with_capacity(t.len());
@@ -151,9 +153,7 @@ pub fn delayed(x: &[f64], delay_s: f64, dt: f64) -> Vec<f64> {
             let u = pos - i;
             let i = i as i64;
             let (p0, p1, p2, p3) = (at(i - 1), at(i), at(i + 1), at(i + 2));
-            p1 + 0.5
-                * u
-                * (p2 - p0 + u * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + u * (3.0 * (p1 - p2) + p3 - p0)))
+            p1 + 0.5 * u * (p2 - p0 + u * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + u * (3.0 * (p1 - p2) + p3 - p0)))
         })
         .collect()
 }

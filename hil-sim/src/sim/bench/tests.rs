@@ -5,13 +5,7 @@ fn every_effect_and_form_reaches_its_size_on_every_family() {
     for (e, forms) in EFFECTS {
         for form in 0..*forms {
             for f in FAMILIES {
-                let c = Case {
-                    form,
-                    duration_s: 6.0,
-                    fs_hz: 1000.0,
-                    size: 0.05,
-                    ..Case::draw(e, f, "multisine", 3)
-                };
+                let c = Case { form, duration_s: 6.0, fs_hz: 1000.0, size: 0.05, ..Case::draw(e, f, "multisine", 3) };
                 let g = generate(&c).unwrap_or_else(|err| panic!("{e}/{form}/{f}: {err}"));
                 let share = g.label.effect_rms_nm / g.label.span_nm;
                 assert!((share - 0.05).abs() < 0.005, "{e}/{form} ({}) on {f}: {share}", g.label.form);
