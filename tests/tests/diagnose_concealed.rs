@@ -201,7 +201,11 @@ fn bench_table() {
     };
     let n = std::env::var("BENCH_N").ok().and_then(|v| v.parse().ok()).unwrap_or(256);
     let n_null = std::env::var("BENCH_NULL").ok().and_then(|v| v.parse().ok()).unwrap_or(48);
-    let outcomes = run_all(&cases(set, n, n_null));
+    // BENCH_FROM / BENCH_TO: a slice of the list (to share a run between processes).
+    let all = cases(set, n, n_null);
+    let env = |k: &str, d: usize| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
+    let (from, to) = (env("BENCH_FROM", 0).min(all.len()), env("BENCH_TO", all.len()).min(all.len()));
+    let outcomes = run_all(&all[from..to.max(from)]);
     let t = table(&outcomes);
     println!("{t}");
     let (all, worst, alarms) = rates(&outcomes);
