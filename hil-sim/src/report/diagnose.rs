@@ -17,7 +17,7 @@ pub fn section(rep: &mut Report, dir: &Path, stem: &str, d: &Diagnosis, names: (
     let (xl, yl) = (format!("{}{}", names.0, unit(names.0)), format!("{}{}", names.1, unit(names.1)));
     rep.paragraph(&format!(
         "Base model **{}** (fitted on the first {:.0} % with the channels as recorded), held-out R-RMSE {:.2} %, \
-         R² {:.4}; with every finding's term: R-RMSE {:.2} %, R² {:.4}. Residual noise floor {:.4}{}; {} s.",
+         R² {:.4}; with every finding's term: R-RMSE {:.2} %, R² {:.4}. Residual noise floor {:.4}{} RMS; {} s.",
         d.base_model,
         100.0 * (1.0 - d.heldout_fraction),
         100.0 * d.base_heldout.r_rmse,
@@ -28,6 +28,9 @@ pub fn section(rep: &mut Report, dir: &Path, stem: &str, d: &Diagnosis, names: (
         unit(names.1),
         format_args!("{:.1}", d.seconds)
     ));
+    for n in &d.notes {
+        rep.paragraph(&format!("Note: {n}."));
+    }
     if d.findings.is_empty() {
         rep.paragraph("**No finding:** no candidate of the catalog lowers the held-out error by more than chance.");
     } else {
@@ -40,7 +43,14 @@ pub fn section(rep: &mut Report, dir: &Path, stem: &str, d: &Diagnosis, names: (
                     format!("{}", k + 1),
                     format!("`{}`", f.effect),
                     f.summary.clone(),
-                    f.params.iter().map(|(n, v)| format!("{n} = {v:.4e}")).collect::<Vec<_>>().join(", "),
+                    f.params
+                        .iter()
+                        .map(|(n, v)| match f.units.get(n).filter(|u| !u.is_empty()) {
+                            Some(u) => format!("{n} = {v:.4e} {u}"),
+                            None => format!("{n} = {v:.4e}"),
+                        })
+                        .collect::<Vec<_>>()
+                        .join(", "),
                     f.windows.iter().map(|(a, b)| format!("{a:.2}–{b:.2}")).collect::<Vec<_>>().join(", "),
                     format!("{:.2} % → {:.2} %", 100.0 * f.heldout_before.r_rmse, 100.0 * f.heldout_after.r_rmse),
                     format!("{:.1}", f.evidence.test.t),

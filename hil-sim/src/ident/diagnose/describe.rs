@@ -101,11 +101,16 @@ pub fn finding(d: &Described<'_>) -> Finding {
         params.insert(name.clone(), g);
         if name == "b_sat" || name == "b_0" {
             units.insert(name.clone(), xu.to_owned());
+        } else if name.ends_with("_s") {
+            units.insert(name.clone(), "s".to_owned());
         }
     }
     let n_old = reference.terms.len();
     for (t, b) in f.terms.iter().zip(&f.beta).skip(n_old) {
         params.insert(t.name.clone(), *b);
+        if let Some(u) = coefficient_unit(&t.name, d.names, c.channel.as_deref()) {
+            units.insert(t.name.clone(), u);
+        }
     }
     params.insert("term_rms".into(), term_rms);
     units.insert("term_rms".into(), yu.to_owned());
@@ -218,6 +223,26 @@ fn what(d: &Described<'_>) -> String {
         ),
         other => other.to_owned(),
     }
+}
+
+/// The unit of a term's coefficient `name` (input and output channel names, the channel
+/// the term uses), `None` for a dimensionless scale (`alpha`, `kappa_…`).
+fn coefficient_unit(name: &str, (i, o): (&str, &str), ch: Option<&str>) -> Option<String> {
+    let (xu, yu) = (unit_or(i), unit_or(o));
+    let cu = ch.map(unit_or).unwrap_or_default();
+    Some(match name {
+        "c_rate" => format!("{yu} per ({xu}/s)²"),
+        "delta" | "k_input" => format!("{yu} per {xu}"),
+        "m" if ch.is_some() => format!("{yu} per ({cu})"),
+        "m" => format!("{yu} per ({xu}/s²)"),
+        "j" if yu == "N·m" && cu == "rad/s" => "kg·m²".to_owned(),
+        "j" => format!("{yu} per ({cu}/s)"),
+        "c_omega" | "c_omega_field" => format!("{yu} per ({cu})"),
+        "offset" | "offset_per_unit" => format!("{yu} per {cu}"),
+        "offset_energy" => yu,
+        "kappa_per_unit" | "alpha" => format!("1 per {cu}"),
+        _ => return None,
+    })
 }
 
 /// The unit of channel `name`, or `unit of <name>` when it is not a known one.
