@@ -9,10 +9,13 @@ fn corpus(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/corpus").join(name)
 }
 
+/// A parameter file of its own for each caller (the tests run in parallel: one shared file
+/// could be read while another test rewrites it).
 fn params() -> PathBuf {
+    static N: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let dir = std::env::temp_dir().join(format!("hil-sim-broken-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let p = dir.join("p.json");
+    let p = dir.join(format!("p{}.json", N.fetch_add(1, std::sync::atomic::Ordering::SeqCst)));
     std::fs::write(&p, r#"{"model":"algebraic","params":{"k":1,"c":0,"alpha":0,"t0":0}}"#).unwrap();
     p
 }

@@ -208,6 +208,7 @@ fn diagnosis(rep: &mut Report, out: &Path, text: &mut String) -> anyhow::Result<
         rate: None,
         seed: 1,
         max_findings: 3,
+        ..Default::default()
     };
     let (diag, _) = super::diagnose::run_diagnosis(&diag_rec, &diag_ch, false, &diag_opts)?;
     rep.heading("Diagnosis: what Bouc–Wen misses on ranran_50.csv (`hil-sim diagnose --model bouc_wen`)");

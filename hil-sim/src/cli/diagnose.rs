@@ -112,6 +112,7 @@ pub fn run(a: DiagnoseArgs) -> anyhow::Result<()> {
         rate: None,
         seed: a.seed,
         max_findings: a.max_findings,
+        ..DiagnoseOptions::default()
     };
     opts.check().map_err(flagged)?;
     if let Some(m) = &opts.model {
@@ -143,13 +144,17 @@ pub fn run(a: DiagnoseArgs) -> anyhow::Result<()> {
 
 /// The diagnosis in words.
 pub fn text(d: &Diagnosis) -> String {
+    let unit = if d.units.1.is_empty() { "(output units)" } else { d.units.1.as_str() };
     let mut s = format!(
-        "base model {}: held-out R-RMSE {:.2} %, R² {:.4} (residual noise floor {:.4})\n",
+        "base model {}: held-out R-RMSE {:.2} %, R² {:.4} (residual noise floor {} RMS)\n",
         d.base_model,
         100.0 * d.base_heldout.r_rmse,
         d.base_heldout.r2,
-        d.locate.noise_rms
+        hil_sim::numerics::number::with_unit(d.locate.noise_rms, 4, unit)
     );
+    for n in &d.notes {
+        s += &format!("note: {n}\n");
+    }
     if d.findings.is_empty() {
         s += "no finding: nothing in the catalog lowers the held-out error by more than chance\n";
     }
@@ -159,7 +164,7 @@ pub fn text(d: &Diagnosis) -> String {
             let w: Vec<String> = f.windows.iter().map(|(a, b)| format!("{a:.2}-{b:.2} s")).collect();
             s += &format!("   where: {}", w.join(", "));
             if let Some(c) = f.conditions.first() {
-                s += &format!("; mostly at {} {} ({:.1}x its share of samples)", c.variable, c.bin, c.concentration);
+                s += &format!("; mostly at {} {} ({:.1}× its share of samples)", c.variable, c.bin, c.concentration);
             }
             s += "\n";
         }

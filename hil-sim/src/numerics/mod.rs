@@ -6,6 +6,7 @@ pub mod derivative;
 pub mod lstsq;
 pub mod metrics;
 pub mod nnls;
+pub mod number;
 pub mod stats;
 pub mod units;
 

@@ -5,11 +5,11 @@
 
 use std::path::Path;
 
-use super::number::{num, with_unit};
 use super::plot::{self, colour, PlotError, Series, Style};
 use super::Report;
 use crate::ident::diagnose::diagnosis::{Diagnosis, Finding, PlotData};
 use crate::ident::diagnose::locate;
+use crate::numerics::number::{num, with_unit};
 use crate::numerics::units::unit_of;
 
 /// Longest stretch the before/after residual plot shows, seconds.
@@ -38,6 +38,9 @@ pub fn section(rep: &mut Report, dir: &Path, stem: &str, d: &Diagnosis, names: (
         with_unit(d.locate.noise_rms, 4, out_unit),
         with_unit(d.seconds, 2, "s"),
     ));
+    for n in &d.notes {
+        rep.paragraph(&format!("Note: {n}."));
+    }
     findings_table(rep, d);
     candidates_table(rep, d);
 

@@ -6,10 +6,10 @@ use std::path::Path;
 
 use model_core::control::page::RateSpec;
 
-use super::number::num;
 use super::plot::{self, colour, PlotError, Series, Style};
 use super::Report;
 use crate::ident::fit::{Dataset, FitResult};
+use crate::numerics::number::num;
 
 /// Axis labels with units, e.g. `("D (cm)", "F (N)")`.
 #[derive(Clone, Debug)]

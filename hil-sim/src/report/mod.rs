@@ -16,7 +16,6 @@
 pub mod diagnose;
 pub mod fit;
 pub mod fit_page;
-pub mod number;
 pub mod plot;
 pub mod runs;
 pub mod scores;

@@ -3,9 +3,9 @@
 //! a held-out error below the training error because the held-out part moves less (a
 //! standstill, a calmer stretch).
 
-use super::number::with_unit;
 use crate::ident::dataset::Dataset;
 use crate::ident::fit::FitResult;
+use crate::numerics::number::with_unit;
 use crate::numerics::stats::{min_max, std};
 
 /// Fraction of the overall span within which a channel counts as not moving.

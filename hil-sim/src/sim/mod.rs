@@ -2,6 +2,7 @@
 //! signals, and recordings with a concealed effect.
 
 pub mod accuracy;
+pub mod bench;
 pub mod concealed;
 pub mod excitation;
 pub mod plant;

@@ -1,7 +1,8 @@
 //! Stage 4 of a diagnosis, modelling: in the round's ranking, the first candidate that
 //! lowers the training error, gains on the information criterion, passes the held-out
-//! block test ([`super::significance`]) and changes the prediction by more than the
-//! residual's noise floor resolves is kept; every candidate is recorded as tested.
+//! block test ([`super::significance`]), changes the prediction by more than the
+//! residual's noise floor resolves and is physically possible ([`super::physical`]) is
+//! kept; every candidate is recorded as tested.
 
 use super::augment::Fitted;
 use super::candidates::Candidate;
@@ -41,11 +42,15 @@ impl Judge<'_> {
         metrics(&pick(self.y), &pick(pred), None)
     }
 
-    /// Judge the `ranked` candidates of round `round` (1-based) against `reference`.
+    /// Judge the `ranked` candidates of round `round` (1-based) against `reference`: of the
+    /// eligible ones (a training gain, significant on the held-out blocks, resolvable above
+    /// the noise, physically possible), the one with the lowest held-out error is kept — the
+    /// term that predicts data it was not fitted on best, not the one that fits the
+    /// training part best (a wrong term on a misfitting base can fit more and predict less).
     pub fn round(&self, round: usize, cands: &[Candidate], reference: &Fitted, ranked: Vec<Scored>) -> Verdict {
         let before = self.heldout(&reference.pred);
         let mut tested = Vec::with_capacity(ranked.len());
-        let mut accepted = None;
+        let mut judged = Vec::with_capacity(ranked.len());
         for s in ranked {
             let (c, f) = (&cands[s.index], &s.fitted);
             let test = significance::test(self.y, &reference.pred, &f.pred, self.held);
@@ -55,7 +60,8 @@ impl Judge<'_> {
                 / self.rows.len().max(1) as f64)
                 .sqrt();
             let resolvable = change >= significance::MIN_TERM_OF_NOISE * self.noise_rms;
-            let kept = accepted.is_none()
+            let impossible = super::physical::impossible(c, f, reference.terms.len(), s.value);
+            let eligible = impossible.is_none()
                 && s.bic_gain > 0.0
                 && f.train_mse < reference.train_mse
                 && test.significant
@@ -69,12 +75,18 @@ impl Judge<'_> {
                 heldout_r_rmse_before: before.r_rmse,
                 heldout_r_rmse_after: after.r_rmse,
                 test,
-                kept,
+                kept: false,
+                impossible,
             });
-            if kept {
-                accepted = Some(Accepted { scored: s, test, after });
-            }
+            judged.push((eligible, s, test, after));
         }
+        let best =
+            (0..judged.len()).filter(|&k| judged[k].0).min_by(|&a, &b| judged[a].3.rmse.total_cmp(&judged[b].3.rmse));
+        let accepted = best.map(|k| {
+            tested[k].kept = true;
+            let (_, s, test, after) = judged.swap_remove(k);
+            Accepted { scored: s, test, after }
+        });
         Verdict { before, tested, accepted }
     }
 }

@@ -37,6 +37,8 @@ pub struct Base {
     pub fit: FitResult,
     /// Every base model fitted, with its held-out R-RMSE.
     pub tried: Vec<(String, f64)>,
+    /// The base models `auto` could not fit, with why.
+    pub failed: Vec<String>,
     pub sim: Box<dyn Simulator>,
     pub spec: ModelSpec,
 }
@@ -70,13 +72,16 @@ pub fn fit_base(
         match fit(id, data, &fit_opts) {
             Ok(r) => fits.push(r),
             Err(e) if opts.model.is_some() => return Err(e.into()),
-            Err(e) => errors.push(format!("{id}: {e}")),
+            Err(e) => errors.push(format!("the base model {id} could not be fitted: {e}")),
         }
         progress.advance(1);
     }
     let score = |r: &FitResult| r.heldout_unflagged.unwrap_or(r.heldout).rmse;
     let tried: Vec<(String, f64)> =
         fits.iter().map(|r| (r.model.clone(), r.heldout_unflagged.unwrap_or(r.heldout).r_rmse)).collect();
+    for r in fits.iter().filter(|r| !score(r).is_finite()) {
+        errors.push(format!("the base model {} was fitted but its held-out prediction is not finite", r.model));
+    }
     let best = fits
         .into_iter()
         .filter(|r| score(r).is_finite())
@@ -91,7 +96,7 @@ pub fn fit_base(
     if !matches!(spec.strategy, Strategy::Linear | Strategy::Local | Strategy::Global) {
         return Err(DiagnoseError::NotParametric(id));
     }
-    Ok(Base { fit: best, tried, sim, spec })
+    Ok(Base { fit: best, tried, failed: errors, sim, spec })
 }
 
 /// The training and held-out (unflagged) rows away from the ends.

@@ -7,6 +7,10 @@
 //!
 //! - a copy of the input's rate (|corr(a, ẋ)| ≥ 0.9, e.g. the Dyke files' `V`): the model
 //!   already has the rate; not a cause;
+//! - a channel the input explains (R² ≥ [`FOLLOWS_R2`] of `a` on `x`, `x²`, `ẋ` and
+//!   `tanh(ẋ/ε)`, e.g. a coil current next to its field, with eddy lag and remanence):
+//!   what it could add is a function of the input, which the input's own candidates test
+//!   by name; not a cause;
 //! - the input's acceleration (|corr(a, ẍ)| ≥ 0.6, e.g. the Dyke files' `A`): the `inertia`
 //!   regressor, measured instead of differentiated twice;
 //! - a temperature (name `temp…`, `theta`, `oil`): the `thermal_drift` state;
@@ -26,6 +30,8 @@ use crate::numerics::stats::{mean, std};
 pub enum Role {
     /// A copy of the input's rate: not used.
     InputRate,
+    /// Explained by the input and its rate: not used.
+    FollowsInput,
     InputAcceleration,
     Temperature,
     Speed,
@@ -131,6 +137,8 @@ pub fn classify(data: &Dataset, aux: Vec<(String, Vec<f64>)>, command: Option<&s
                 Role::InputRate
             } else if acceleration_corr(&values, &data.input, &ddx).abs() >= 0.6 {
                 Role::InputAcceleration
+            } else if explained_by_input(&values, &data.input, &dx) >= FOLLOWS_R2 {
+                Role::FollowsInput
             } else if ["temp", "theta", "oil", "therm"].iter().any(|k| lower.contains(k)) {
                 Role::Temperature
             } else if ["speed", "omega", "rpm", "slip"].iter().any(|k| lower.contains(k)) || lower == "w" {
@@ -143,6 +151,29 @@ pub fn classify(data: &Dataset, aux: Vec<(String, Vec<f64>)>, command: Option<&s
             AuxChannel { name, role, values }
         })
         .collect()
+}
+
+/// Share of a channel's variance the input must explain for it to be taken as following
+/// the input.
+pub const FOLLOWS_R2: f64 = 0.98;
+
+/// R² of `v` regressed on the input `x`, `x²`, its rate `dx` and `tanh(dx/ε)` (ε a tenth of
+/// the rate's spread); 0 when the fit fails or `v` has non-finite entries.
+fn explained_by_input(v: &[f64], x: &[f64], dx: &[f64]) -> f64 {
+    if v.iter().any(|a| !a.is_finite()) {
+        return 0.0;
+    }
+    let eps = 0.1 * std(dx).max(1e-300);
+    let rows: Vec<[f64; 5]> = x.iter().zip(dx).map(|(x, d)| [1.0, *x, x * x, *d, (d / eps).tanh()]).collect();
+    let Some(th) = crate::numerics::lstsq::fit_rows(&rows, v) else { return 0.0 };
+    let res: Vec<f64> =
+        rows.iter().zip(v).map(|(r, a)| a - r.iter().zip(&th).map(|(r, t)| r * t).sum::<f64>()).collect();
+    let (sr, sv) = (std(&res), std(v));
+    if sv > 0.0 {
+        1.0 - (sr / sv).powi(2)
+    } else {
+        0.0
+    }
 }
 
 /// Replace non-finite entries by the previous finite value.
@@ -210,11 +241,17 @@ fn additive(
     }
 }
 
-/// Every candidate for this recording.
-pub fn all(data: &Dataset, aux: &[AuxChannel]) -> Vec<Candidate> {
+/// Every candidate for this recording; `input_is_field`: the input is a magnetic field
+/// (unit T), which has no mass, so `m·ẍ` of it is no inertia (a clutch's inertia shows
+/// through a speed channel).
+pub fn all(data: &Dataset, aux: &[AuxChannel], input_is_field: bool) -> Vec<Candidate> {
     let s = InputStats::of(data);
     let mut out = input_transforms(&s);
-    out.extend(kinematic_terms(&s, aux));
+    out.extend(
+        kinematic_terms(&s, aux)
+            .into_iter()
+            .filter(|c| !(input_is_field && c.effect == "inertia" && c.channel.is_none())),
+    );
     out.extend(thermal(data, &s, aux));
     for c in aux.iter().filter(|a| a.role == Role::Speed) {
         out.extend(speed(&s, c));
@@ -230,7 +267,10 @@ pub fn all(data: &Dataset, aux: &[AuxChannel]) -> Vec<Candidate> {
 fn input_transforms(s: &InputStats) -> Vec<Candidate> {
     let dt = s.dt;
     let fs = 1.0 / dt;
-    let max_delay = (0.02 * fs).round().clamp(4.0, 40.0);
+    // ±20 ms (at least 4 samples), in at most 40 steps each way.
+    let reach = (0.02 * fs).round().max(4.0);
+    let stride = (reach / 40.0).ceil();
+    let max_delay = (reach / stride).round();
     vec![
         Candidate {
             effect: "field_lag",
@@ -244,7 +284,10 @@ fn input_transforms(s: &InputStats) -> Vec<Candidate> {
             effect: "transport_delay",
             label: "time shift between input and output".into(),
             grid_name: Some("delay_s".into()),
-            grid: (-(max_delay as i64)..=max_delay as i64).filter(|k| *k != 0).map(|k| k as f64 * dt).collect(),
+            grid: (-(max_delay as i64)..=max_delay as i64)
+                .filter(|k| *k != 0)
+                .map(|k| k as f64 * stride * dt)
+                .collect(),
             build: Box::new(|d| Piece { transform: Some(Transform::Delay { delay_s: d }), terms: vec![] }),
             channel: None,
         },

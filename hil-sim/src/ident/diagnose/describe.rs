@@ -8,7 +8,7 @@ use std::collections::BTreeMap;
 
 use super::augment::Fitted;
 use super::candidates::Candidate;
-use super::diagnosis::{Evidence, Finding};
+use super::diagnosis::{Evidence, Finding, Tested};
 use super::locate::{self, Condition};
 use super::significance::Test;
 use crate::ident::fit::Dataset;
@@ -37,6 +37,45 @@ pub struct Described<'a> {
     pub aux: &'a [(&'a str, &'a [f64])],
     /// Rows the term's size and the conditions are taken over.
     pub rows: &'a [usize],
+    /// Sample indices where runs of a multi-run recording join.
+    pub boundaries: &'a [usize],
+    /// The candidate that does nearly as well, when the evidence is weak.
+    pub runner_up: Option<String>,
+}
+
+/// When the kept candidate's evidence is weak (t below twice the threshold, or another
+/// effect's significant candidate within 5 % of its held-out error), that candidate in
+/// words: its effect and term.
+pub fn runner_up(tested: &[Tested], round: usize, kept: &str, test: &Test, after_r_rmse: f64) -> Option<String> {
+    let other = tested
+        .iter()
+        .filter(|t| t.round == round && t.effect != kept && t.impossible.is_none() && t.test.significant)
+        .min_by(|a, b| a.heldout_r_rmse_after.total_cmp(&b.heldout_r_rmse_after))?;
+    let close = other.heldout_r_rmse_after <= 1.05 * after_r_rmse;
+    (close || test.t < 2.0 * super::significance::T_MIN).then(|| format!("{} ({})", other.effect, other.label))
+}
+
+/// Where the windows sit on run boundaries or flagged samples, in words (empty when not).
+fn caveats(data: &Dataset, windows: &[(f64, f64)], boundaries: &[usize]) -> String {
+    let near = |a: f64, b: f64, t: f64| t >= a - 0.05 && t <= b + 0.05;
+    let on_boundary: Vec<String> = boundaries
+        .iter()
+        .filter_map(|&k| data.time.get(k))
+        .filter(|&&t| windows.iter().any(|&(a, b)| near(a, b, t)))
+        .map(|t| format!("{t:.2} s"))
+        .collect();
+    let flagged = windows.iter().any(|&(a, b)| data.time.iter().zip(&data.excluded).any(|(&t, &x)| x && near(a, b, t)));
+    let mut out = String::new();
+    if !on_boundary.is_empty() {
+        out += &format!(
+            "; its windows sit on the joins between runs (at {}): check that the term is not the join itself",
+            on_boundary.join(", ")
+        );
+    }
+    if flagged {
+        out += "; its windows touch samples the quality check flagged: check the recording there";
+    }
+    out
 }
 
 pub use crate::numerics::units::unit_of;
@@ -62,22 +101,34 @@ pub fn finding(d: &Described<'_>) -> Finding {
         params.insert(name.clone(), g);
         if name == "b_sat" || name == "b_0" {
             units.insert(name.clone(), xu.to_owned());
+        } else if name.ends_with("_s") {
+            units.insert(name.clone(), "s".to_owned());
         }
     }
     let n_old = reference.terms.len();
     for (t, b) in f.terms.iter().zip(&f.beta).skip(n_old) {
         params.insert(t.name.clone(), *b);
+        if let Some(u) = coefficient_unit(&t.name, d.names, c.channel.as_deref()) {
+            units.insert(t.name.clone(), u);
+        }
     }
     params.insert("term_rms".into(), term_rms);
     units.insert("term_rms".into(), yu.to_owned());
-    let size =
-        format!("it changes the {} by {} RMS ({:.1} % of its span)", d.names.1, with_unit(term_rms, yu), 100.0 * share);
+    let size = format!(
+        "it changes the {} by {} RMS ({:.1} % of its span)",
+        d.names.1,
+        with_unit(term_rms, &unit_or(d.names.1)),
+        100.0 * share
+    );
+    let weak =
+        d.runner_up.as_ref().map(|r| format!("; the evidence is weak: the runner-up is {r}")).unwrap_or_default();
     let summary = format!(
-        "{}; {size}; held-out R-RMSE {:.2} % -> {:.2} % ({:.0} % lower)",
+        "{}; {size}; held-out R-RMSE {:.2} % -> {:.2} % ({:.0} % lower){weak}{}",
         what(d),
         100.0 * d.before.r_rmse,
         100.0 * d.after.r_rmse,
-        100.0 * d.test.gain
+        100.0 * d.test.gain,
+        caveats(data, &windows, d.boundaries)
     );
     Finding {
         effect: c.effect.to_owned(),
@@ -96,6 +147,7 @@ pub fn finding(d: &Described<'_>) -> Finding {
             term_share_of_span: share,
             bic_gain: d.bic_gain,
         },
+        runner_up: d.runner_up.clone(),
     }
 }
 
@@ -103,8 +155,9 @@ pub fn finding(d: &Described<'_>) -> Finding {
 fn what(d: &Described<'_>) -> String {
     let (c, f, g, dt) = (d.candidate, d.fitted, d.value, d.data.dt);
     let (i, o) = d.names;
-    let (xu, yu) = (unit_of(i).unwrap_or(""), unit_of(o).unwrap_or(""));
+    let (xu, yu) = (unit_or(i), unit_or(o));
     let coef = f.beta.get(d.reference.terms.len()).copied().unwrap_or(0.0);
+    let coef2 = f.beta.get(d.reference.terms.len() + 1).copied().unwrap_or(0.0);
     let ch = c.channel.clone().unwrap_or_default();
     match c.effect {
         "field_lag" => format!(
@@ -123,42 +176,92 @@ fn what(d: &Described<'_>) -> String {
         ),
         "saturation" => format!(
             "the {i} saturates: the {o} follows b_s·tanh(b/b_s) with b_s = {} (yield stress or steel saturating at high field)",
-            with_unit(g, xu)
+            with_unit(g, &xu)
         ),
         "sensor_offset" => {
-            format!("the {i} reading carries a zero offset of {} (Hall offset or remanent field)", with_unit(g, xu))
+            format!("the {i} reading carries a zero offset of {} (Hall offset or remanent field)", with_unit(g, &xu))
         }
         "rate_dependence" => format!(
-            "the loop changes with the excitation rate beyond the model's linear rate term (a |rate|·rate term, coefficient {coef:.3e})"
+            "the loop changes with the excitation rate beyond the model's linear rate term (a |rate|·rate term, coefficient {} per ({xu}/s)²)",
+            with_unit(coef, &yu)
         ),
         "asymmetry" => {
-            format!("loading and unloading differ by an amount growing with the {i} (δ = {coef:.3e} {yu} per {xu})")
+            format!("loading and unloading differ by an amount growing with the {i} (δ = {} per {xu})", with_unit(coef, &yu))
         }
         "thermal_drift" if !ch.is_empty() => format!(
-            "the {o} drifts with the temperature channel {ch} (scale {coef:+.3e} per unit, the fluid's viscosity and yield stress falling as it heats)"
+            "the {o} drifts with the temperature channel {ch} (scale {} per {}, offset {} per {}: the fluid's viscosity and yield stress falling as it heats); or a slow offset drift",
+            with_unit(100.0 * coef, "%"),
+            unit_or(&ch),
+            with_unit(coef2, &yu),
+            unit_or(&ch)
         ),
         "thermal_drift" => format!(
-            "the {o} drifts with the energy dissipated so far (the fluid heating up: scale {coef:+.3} over the recording)"
+            "the {o} drifts with the energy dissipated so far (the fluid heating up: scale {} and offset {} over the recording); or a slow offset drift",
+            with_unit(100.0 * coef, "%"),
+            with_unit(coef2, &yu)
         ),
-        "slip_speed" => format!("the {o} depends on the slip speed {ch} (viscous shear the field-only model ignores)"),
+        "slip_speed" => format!(
+            "the {o} depends on the slip speed {ch} (viscous shear the field-only model ignores): {} per ({}), and {} per ({}) at the largest {i}",
+            with_unit(coef, &yu),
+            unit_or(&ch),
+            with_unit(coef2, &yu),
+            unit_or(&ch)
+        ),
         "inertia" if !ch.is_empty() => {
-            format!("an inertial term in the {o} follows the acceleration from {ch} (coefficient {coef:.3e})")
+            let measured = c.label.contains("measured acceleration");
+            let per = if measured { unit_or(&ch) } else { format!("{}/s", unit_or(&ch)) };
+            format!("an inertial term in the {o} follows the acceleration from {ch} ({})", inertia(coef, &yu, &per))
         }
-        "inertia" => format!("an inertial term m·ẍ in the {o} (m = {coef:.3e} {yu} per {xu}/s²; fluid or piston mass)"),
+        "inertia" => {
+            format!("an inertial term m·ẍ in the {o} (m = {} per ({xu}/s²); fluid or piston mass)", with_unit(coef, &yu))
+        }
         "aux_dependence" => format!(
-            "the {o} depends on the channel {ch}: the model's parameters scale with it (α = {coef:+.3e} per unit of {ch}), and the dependence lags {ch} by a first-order lag of {:.1} ms",
+            "the {o} depends on the channel {ch}: the model's parameters scale with it (α = {} per {}), and the dependence lags {ch} by a first-order lag of {:.1} ms",
+            with_unit(100.0 * coef, "%"),
+            unit_or(&ch),
             1e3 * g
         ),
         other => other.to_owned(),
     }
 }
 
-/// `v` with 3 decimals (or in scientific notation when very large or small) and its unit.
-fn with_unit(v: f64, unit: &str) -> String {
-    let s = if v != 0.0 && (v.abs() >= 1e4 || v.abs() < 1e-2) { format!("{v:.3e}") } else { format!("{v:.3}") };
-    if unit.is_empty() {
-        s
-    } else {
-        format!("{s} {unit}")
+/// The unit of a term's coefficient `name` (input and output channel names, the channel
+/// the term uses), `None` for a dimensionless scale (`alpha`, `kappa_…`).
+fn coefficient_unit(name: &str, (i, o): (&str, &str), ch: Option<&str>) -> Option<String> {
+    let (xu, yu) = (unit_or(i), unit_or(o));
+    let cu = ch.map(unit_or).unwrap_or_default();
+    Some(match name {
+        "c_rate" => format!("{yu} per ({xu}/s)²"),
+        "delta" | "k_input" => format!("{yu} per {xu}"),
+        "m" if ch.is_some() => format!("{yu} per ({cu})"),
+        "m" => format!("{yu} per ({xu}/s²)"),
+        "j" if yu == "N·m" && cu == "rad/s" => "kg·m²".to_owned(),
+        "j" => format!("{yu} per ({cu}/s)"),
+        "c_omega" | "c_omega_field" => format!("{yu} per ({cu})"),
+        "offset" | "offset_per_unit" => format!("{yu} per {cu}"),
+        "offset_energy" => yu,
+        "kappa_per_unit" | "alpha" => format!("1 per {cu}"),
+        _ => return None,
+    })
+}
+
+/// The unit of channel `name`, or `unit of <name>` when it is not a known one.
+fn unit_or(name: &str) -> String {
+    unit_of(name).map_or_else(|| format!("unit of {name}"), str::to_owned)
+}
+
+/// An inertia coefficient in words (`chu`: the unit of the acceleration it multiplies):
+/// `kg·m²` for a torque against rad/s², `kg` for a force against m/s², else the output's
+/// unit per the acceleration's.
+fn inertia(coef: f64, yu: &str, chu: &str) -> String {
+    match (yu, chu) {
+        ("N·m", "rad/s/s") => format!("J = {}", with_unit(coef, "kg·m²")),
+        ("N", "m/s/s" | "m/s²") => format!("m = {}", with_unit(coef, "kg")),
+        _ => format!("coefficient {} per ({chu})", with_unit(coef, yu)),
     }
+}
+
+/// `v` with 4 significant digits (a power of ten written out, never e-notation) and its unit.
+fn with_unit(v: f64, unit: &str) -> String {
+    crate::numerics::number::with_unit(v, 4, unit)
 }

@@ -29,6 +29,9 @@ pub struct Finding {
     pub conditions: Vec<Condition>,
     /// The candidate as tested (label, channel, test outcome, size).
     pub evidence: Evidence,
+    /// When the evidence is weak, the candidate that does nearly as well (effect and term).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub runner_up: Option<String>,
 }
 
 /// How a candidate fared.
@@ -60,6 +63,9 @@ pub struct Tested {
     pub heldout_r_rmse_after: f64,
     pub test: Test,
     pub kept: bool,
+    /// Why its fitted values are physically impossible (then it is never kept).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub impossible: Option<String>,
 }
 
 /// The whole diagnosis.
@@ -77,6 +83,11 @@ pub struct Diagnosis {
     pub locate: Locate,
     pub channels: Vec<AuxChannel>,
     pub candidates: Vec<Tested>,
+    /// What the diagnosis could not do, in words: a base model `auto` could not fit and why,
+    /// a round stopped because the base model's Jacobian could not be taken.
+    pub notes: Vec<String>,
+    /// Units of the input and the output channel (empty when the names are not known ones).
+    pub units: (String, String),
     pub seconds: f64,
     #[serde(skip)]
     pub plot: PlotData,

@@ -34,6 +34,7 @@ pub mod diagnosis;
 pub mod leak;
 pub mod locate;
 pub mod options;
+pub mod physical;
 pub mod profile;
 pub mod rank;
 pub mod refit;
@@ -99,7 +100,7 @@ pub fn diagnose(
     progress.advance(1);
 
     // 3–4. Name and model, round by round.
-    let cands = candidates::all(data, &channels);
+    let cands = candidates::all(data, &channels, unit_of(names.0) == Some("T"));
     // The base as the refits see it: Gauss–Newton run on from the fit until it stalls, so
     // that a term is never credited with what more iterations of the base would have done.
     let diverges = || DiagnoseError::Diverges(id.clone());
@@ -107,15 +108,22 @@ pub fn diagnose(
     let mut findings = Vec::new();
     let mut tested = Vec::new();
     let mut used: Vec<usize> = Vec::new();
-    let y_span = {
-        let y = &data.output;
-        let (lo, hi) = held.iter().fold((f64::MAX, f64::MIN), |(l, h), &i| (l.min(y[i]), h.max(y[i])));
-        (hi - lo).max(1e-300)
-    };
+    let y_span = span_on(&data.output, &held);
+    let mut notes = base.failed.clone();
+    // Joins of a dataset's runs, with any the caller gave: a finding sitting on one says so.
+    let boundaries: Vec<usize> =
+        opts.boundaries.iter().copied().chain(data.run_starts().into_iter().filter(|&s| s > 0)).collect();
     for round in 0..opts.max_findings {
         progress.message(&format!("round {}: naming", round + 1));
         let reference = rank::reference(&prob, &current).ok_or_else(diverges)?;
-        let Some(ranked) = rank::rank(&prob, &cands, &reference, &used) else { break };
+        let Some(ranked) = rank::rank(&prob, &cands, &reference, &used) else {
+            notes.push(format!(
+                "round {}: the base model {id}'s Jacobian could not be taken at its fitted parameters (its \
+                 replay diverges when a parameter is nudged), so no further candidate was tested",
+                round + 1
+            ));
+            break;
+        };
         progress.advance(1);
         progress.message(&format!("round {}: testing", round + 1));
         let verdict = judge.round(round + 1, &cands, &reference, ranked);
@@ -123,6 +131,7 @@ pub fn diagnose(
         progress.advance(1);
         let Some(kept) = verdict.accepted else { break };
         let c = &cands[kept.scored.index];
+        let runner_up = describe::runner_up(&tested, round + 1, c.effect, &kept.test, kept.after.r_rmse);
         findings.push(describe::finding(&Described {
             data,
             candidate: c,
@@ -138,14 +147,12 @@ pub fn diagnose(
             rate: &dx,
             aux: &aux_refs,
             rows: &all_rows,
+            boundaries: &boundaries,
+            runner_up,
         }));
         used.push(kept.scored.index);
         // A candidate of the same effect on the same channel is not tested again.
-        for (j, o) in cands.iter().enumerate() {
-            if o.effect == c.effect && o.channel == c.channel {
-                used.push(j);
-            }
-        }
+        used.extend((0..cands.len()).filter(|&j| cands[j].effect == c.effect && cands[j].channel == c.channel));
         current = kept.scored.fitted;
     }
     let unchanged = current.transforms.is_empty() && current.terms.is_empty();
@@ -159,6 +166,8 @@ pub fn diagnose(
         locate: located,
         channels,
         candidates: tested,
+        notes,
+        units: (unit_of(names.0).unwrap_or("").to_owned(), unit_of(names.1).unwrap_or("").to_owned()),
         seconds: started.elapsed().as_secs_f64(),
         plot: PlotData {
             time: data.time.clone(),
@@ -171,6 +180,12 @@ pub fn diagnose(
             fs: 1.0 / data.dt,
         },
     })
+}
+
+/// Peak-to-peak of `y` over `rows`.
+fn span_on(y: &[f64], rows: &[usize]) -> f64 {
+    let (lo, hi) = rows.iter().fold((f64::MAX, f64::MIN), |(l, h), &i| (l.min(y[i]), h.max(y[i])));
+    (hi - lo).max(1e-300)
 }
 
 /// Keep `Transform` in the public surface for the report.

@@ -39,11 +39,14 @@ pub struct DiagnoseOptions {
     pub seed: u64,
     /// Rounds of naming and modelling.
     pub max_findings: usize,
+    /// Sample indices where one run of a multi-run recording ends and the next begins; a
+    /// finding whose windows sit on them says so.
+    pub boundaries: Vec<usize>,
 }
 
 impl Default for DiagnoseOptions {
     fn default() -> Self {
-        Self { model: None, heldout: 0.3, rate: None, seed: 1, max_findings: 3 }
+        Self { model: None, heldout: 0.3, rate: None, seed: 1, max_findings: 3, boundaries: Vec::new() }
     }
 }
 

@@ -1,0 +1,36 @@
+//! Whether a candidate's fitted values are physically possible: a finding is never a
+//! negative mass or inertia, a time constant or saturation level that is not positive,
+//! or a lag, delay or channel lag pinned at the edge of its search range (the refit
+//! wanted more than the range allows: the term is standing in for something else).
+
+use super::augment::Fitted;
+use super::candidates::Candidate;
+
+/// Why the fitted candidate is impossible (in words, with the value and its unit), or
+/// `None` when it is possible. `n_old` is the number of terms the reference already had.
+pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64) -> Option<String> {
+    let coef = f.beta.get(n_old).copied().unwrap_or(0.0);
+    if c.effect == "inertia" && coef < 0.0 {
+        return Some(format!("a negative mass or inertia ({})", crate::numerics::number::num(coef, 4)));
+    }
+    let name = c.grid_name.as_deref()?;
+    if c.grid.len() < 2 {
+        return None;
+    }
+    let lo = c.grid.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = c.grid.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let at = |edge: f64| (value - edge).abs() <= 1e-3 * (hi - lo).abs().max(1e-300);
+    match name {
+        "tau_s" | "lag_s" if value < 0.0 => Some(format!("a negative time constant ({:.2} ms)", 1e3 * value)),
+        "tau_s" | "lag_s" if value > 0.0 && at(hi) => {
+            Some(format!("a time constant at the edge of its search range ({:.1} ms)", 1e3 * value))
+        }
+        "delay_s" if at(hi) || at(lo) => {
+            Some(format!("a delay at the edge of its search range ({:+.2} ms)", 1e3 * value))
+        }
+        "b_sat" if value <= 0.0 => {
+            Some(format!("a saturation level that is not positive ({})", crate::numerics::number::num(value, 4)))
+        }
+        _ => None,
+    }
+}

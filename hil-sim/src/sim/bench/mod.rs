@@ -1,0 +1,257 @@
+//! The blind test bench of `hil-sim diagnose` (issue 20): clutch recordings with one
+//! concealed catalog effect (shared/spec/physics-catalog.md) or none, written from the
+//! physics by code that shares nothing with the diagnosis — not its transforms, not its
+//! models (the base truths are written here, [`plant`]), not its derivatives or filters
+//! ([`signals`]).
+//!
+//! A [`Case`] is drawn from its seed: the base family ([`plant::FAMILIES`]), the excitation
+//! ([`signals::EXCITATIONS`]: multi-sine, swept sine up and down, blocks of 1–9 Hz sines,
+//! band-limited noise), the sampling rate (500 Hz–10 kHz), unipolar (0.05–0.6 T) or bipolar
+//! (±0.5 T) field, the effect's form ([`effects`]) and its size (3–8 % of the torque span,
+//! RMS). Every recording carries `t,b,torque,i,speed` and, in about half of them,
+//! `temperature`:
+//!
+//! - `i` (A): the coil current, `(b + τ_e·ḃ + b_r·tanh(ḃ/ε))/k`, eddy lag τ_e 1–3 ms and
+//!   remanence b_r 0.01–0.03 T;
+//! - `speed` (rad/s): the slip speed, 15–25 rad/s with slow and 1.5–4 Hz variations;
+//! - `temperature` (°C): the heating state `θ̇ = (g·|T·ω| − θ)/τ_th` above 25 °C, τ_th
+//!   20–200 s, heated 8–15 K over the recording.
+//!
+//! The measurement chain ([`chain`]): the Hall reading on a 12-bit ADC over ±1 T (half a
+//! count of noise), the torque with white noise of 0.3–0.8 % of its span and a 16-bit ADC,
+//! the current on a 12-bit ADC over ±5 A; then the lab's zero-phase low-pass (a
+//! second-order Butterworth run both ways, corner 100–400 Hz, below 0.2·fs) on the field
+//! and the torque.
+//!
+//! The seeds are split: [`Set::Development`] draws from one range, [`Set::Heldout`] from
+//! another; the method is developed on the first and reported on the second.
+
+pub mod chain;
+pub mod effects;
+pub mod plant;
+pub mod signals;
+
+use std::collections::BTreeMap;
+use std::f64::consts::PI;
+
+use rand::{Rng, SeedableRng};
+use serde::Serialize;
+
+use crate::io::recording::Recording;
+pub use effects::EFFECTS;
+pub use plant::FAMILIES;
+pub use signals::EXCITATIONS;
+
+/// Ambient and starting temperature, °C.
+pub const AMBIENT_C: f64 = 25.0;
+/// Sampling rates drawn, Hz.
+pub const RATES_HZ: &[f64] = &[500.0, 1000.0, 2000.0, 5000.0, 10_000.0];
+/// Most samples of one recording (the duration shrinks at the high rates).
+pub const MAX_SAMPLES: f64 = 40_000.0;
+
+/// Which half of the seeds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Set {
+    Development,
+    Heldout,
+}
+
+impl Set {
+    /// The seed of case `k` of this set.
+    pub fn seed(self, k: u64) -> u64 {
+        match self {
+            Set::Development => 10_000 + k,
+            Set::Heldout => 7_300_000 + 7 * k,
+        }
+    }
+}
+
+/// One recording's recipe.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Case {
+    /// `none` or an effect of [`EFFECTS`].
+    pub effect: String,
+    pub family: String,
+    pub excitation: String,
+    pub fs_hz: f64,
+    pub duration_s: f64,
+    pub bipolar: bool,
+    pub temperature_channel: bool,
+    /// Index of the effect's form (modulo its number of forms).
+    pub form: usize,
+    /// RMS of the effect's change, fraction of the torque span.
+    pub size: f64,
+    pub seed: u64,
+}
+
+impl Case {
+    /// The case for `effect`, `family` and `excitation` whose other choices are drawn from
+    /// `seed`.
+    pub fn draw(effect: &str, family: &str, excitation: &str, seed: u64) -> Self {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed ^ 0x005e_ed0f_be4c);
+        let fs_hz = RATES_HZ[rng.random_range(0..RATES_HZ.len())];
+        let duration_s = (MAX_SAMPLES / fs_hz).min(30.0).floor();
+        Self {
+            effect: effect.into(),
+            family: family.into(),
+            excitation: excitation.into(),
+            fs_hz,
+            duration_s,
+            bipolar: rng.random_bool(0.3),
+            temperature_channel: rng.random_bool(0.5),
+            form: rng.random_range(0..6),
+            size: rng.random_range(0.03..0.08),
+            seed,
+        }
+    }
+}
+
+/// The `n` effect cases and `n_null` null cases of a set: effects, excitations and families
+/// cycled so that every effect meets every excitation and the families rotate.
+pub fn cases(set: Set, n: usize, n_null: usize) -> Vec<Case> {
+    let effects: Vec<&str> = EFFECTS.iter().map(|(e, _)| *e).collect();
+    let mut out = Vec::with_capacity(n + n_null);
+    for k in 0..n {
+        let e = effects[k % effects.len()];
+        let x = EXCITATIONS[(k / effects.len()) % EXCITATIONS.len()];
+        let f = FAMILIES[(k + k / (effects.len() * EXCITATIONS.len())) % FAMILIES.len()];
+        out.push(Case::draw(e, f, x, set.seed(k as u64)));
+    }
+    for k in 0..n_null {
+        let x = EXCITATIONS[k % EXCITATIONS.len()];
+        let f = FAMILIES[k % FAMILIES.len()];
+        out.push(Case::draw("none", f, x, set.seed(100_000 + k as u64)));
+    }
+    out
+}
+
+/// What was concealed: kept out of the recording.
+#[derive(Clone, Debug, Serialize)]
+pub struct Label {
+    pub case: Case,
+    pub form: String,
+    pub params: BTreeMap<String, f64>,
+    /// RMS of the effect's change and the torque's span, N·m.
+    pub effect_rms_nm: f64,
+    pub span_nm: f64,
+}
+
+/// The truth before the effect.
+pub struct World {
+    pub dt: f64,
+    pub family: String,
+    pub t: Vec<f64>,
+    /// True field (T), its rate (T/s).
+    pub b: Vec<f64>,
+    pub db: Vec<f64>,
+    /// Coil current (A), slip speed (rad/s), its rate, temperature (°C).
+    pub i: Vec<f64>,
+    pub speed: Vec<f64>,
+    pub domega: Vec<f64>,
+    pub temperature: Vec<f64>,
+    /// The base torque (N·m) and its span.
+    pub base: Vec<f64>,
+    pub span: f64,
+}
+
+/// Why a case cannot be generated.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum BenchError {
+    #[error("unknown base family `{0}` (one of: {list})", list = FAMILIES.join(", "))]
+    Family(String),
+    #[error("the base family `{0}` diverged")]
+    Diverged(String),
+}
+
+impl World {
+    fn new(c: &Case, rng: &mut impl Rng) -> Result<Self, BenchError> {
+        let dt = 1.0 / c.fs_hz;
+        let n = (c.duration_s * c.fs_hz).round() as usize;
+        let t: Vec<f64> = (0..n).map(|k| k as f64 * dt).collect();
+        let s = signals::excitation(&c.excitation, &t, c.duration_s, dt, rng);
+        let b: Vec<f64> = s.iter().map(|s| if c.bipolar { 0.5 * s } else { 0.325 + 0.275 * s }).collect();
+        let db = signals::derivative(&b, dt);
+        let eps = 0.1 * signals::rms_about_mean(&db).max(1e-9);
+        let (tau_e, b_r) = (rng.random_range(0.001..0.003), rng.random_range(0.01..0.03));
+        let i = b.iter().zip(&db).map(|(b, d)| (b + tau_e * d + b_r * (d / eps).tanh()) / 0.2).collect();
+        let (f_fast, ph): (f64, Vec<f64>) =
+            (rng.random_range(1.5..4.0), (0..3).map(|_| rng.random_range(0.0..2.0 * PI)).collect());
+        let w0 = rng.random_range(15.0..25.0);
+        let speed: Vec<f64> = t
+            .iter()
+            .map(|t| {
+                w0 + 3.0 * (2.0 * PI * 0.06 * t + ph[0]).sin()
+                    + 1.5 * (2.0 * PI * 0.37 * t + ph[1]).sin()
+                    + 1.2 * (2.0 * PI * f_fast * t + ph[2]).sin()
+            })
+            .collect();
+        let domega = signals::derivative(&speed, dt);
+        let base = plant::torque(&c.family, &b, &db, dt).ok_or_else(|| {
+            if FAMILIES.contains(&c.family.as_str()) {
+                BenchError::Diverged(c.family.clone())
+            } else {
+                BenchError::Family(c.family.clone())
+            }
+        })?;
+        let (lo, hi) = base.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+        let span = (hi - lo).max(1e-9);
+        let temperature = heating(&base, &speed, dt, rng);
+        Ok(Self { dt, family: c.family.clone(), t, b, db, i, speed, domega, temperature, base, span })
+    }
+}
+
+/// The heating state above ambient, °C: `θ̇ = (g·|T·ω| − θ)/τ_th`, τ_th drawn 20–200 s, the
+/// gain set for a rise of 8–15 K over the recording.
+fn heating(torque: &[f64], speed: &[f64], dt: f64, rng: &mut impl Rng) -> Vec<f64> {
+    let tau = rng.random_range(20.0..200.0);
+    let rise = rng.random_range(8.0..15.0);
+    let power: Vec<f64> = torque.iter().zip(speed).map(|(t, w)| (t * w).abs()).collect();
+    let mut theta = 0.0;
+    let raw: Vec<f64> = power
+        .iter()
+        .map(|p| {
+            theta += dt * (p - theta) / tau;
+            theta
+        })
+        .collect();
+    let end = raw.last().copied().unwrap_or(1.0).max(1e-12);
+    raw.iter().map(|v| AMBIENT_C + rise * v / end).collect()
+}
+
+/// A generated case: the recording and its label.
+pub struct Generated {
+    pub recording: Recording,
+    pub label: Label,
+}
+
+/// Generate case `c`.
+pub fn generate(c: &Case) -> Result<Generated, BenchError> {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(c.seed);
+    let world = World::new(c, &mut rng)?;
+    let applied = if c.effect == "none" {
+        effects::Applied {
+            torque: world.base.clone(),
+            b_reported: world.b.clone(),
+            form: "none".into(),
+            params: BTreeMap::new(),
+            effect_rms: 0.0,
+        }
+    } else {
+        effects::apply(&world, &c.effect, c.form, c.size)
+    };
+    if applied.torque.iter().any(|v| !v.is_finite()) {
+        return Err(BenchError::Diverged(c.family.clone()));
+    }
+    let recording = chain::record(&world, &applied, c, &mut rng);
+    let label = Label {
+        case: c.clone(),
+        form: applied.form,
+        params: applied.params,
+        effect_rms_nm: applied.effect_rms,
+        span_nm: world.span,
+    };
+    Ok(Generated { recording, label })
+}
+
+#[cfg(test)]
+mod tests;
