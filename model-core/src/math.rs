@@ -35,6 +35,125 @@ pub fn ln(x: f32) -> f32 {
 pub fn expm1(x: f32) -> f32 {
     libm::expm1f(x)
 }
+/// `tan(x)` in f32 arithmetic only (libm's `tanf` evaluates in f64: soft-float calls on the
+/// Cortex-M4F, where this sits in the control interrupt). Within 1 ulp of the exact value for
+/// `|x| ≤ 8192` (the Bouc–Wen Riccati leg calls it on `[0, π/2)`; `math/tests.rs` checks
+/// that range against f64 `tan`); NaN for NaN, ±∞ and `|x| > 8192`.
+///
+/// Method (Cody–Waite, as Cephes' `tanf`, in double-f32 where it matters): `j` = the
+/// nearest integer to `x·2/π`, `y = x − j·π/2` with π/2 in four f32 parts (the first two
+/// products and differences are exact for `|x| ≤ 8192`, the third is kept as a hi/lo pair),
+/// `tan(y)` on `|y| ≤ π/4` by `y + y³/3 + y⁵·h(y²)` ([`TAN_H`]) carried as hi + lo with the
+/// reduction's low part, and for odd `j`
+/// `−1/tan(y)` with one Newton correction of the reciprocal (Dekker's exact product).
+pub fn tan(x: f32) -> f32 {
+    let a = abs(x);
+    if a < TAN_TINY {
+        // x²/3 < 2⁻²⁴/3: tan(x) rounds to x (±0 and subnormals included).
+        return x;
+    }
+    if a <= core::f32::consts::FRAC_PI_4 {
+        let (t, t_lo) = tan_kernel(x, 0.0);
+        return t + t_lo;
+    }
+    if !(a <= TAN_MAX) {
+        return f32::NAN;
+    }
+    // 1.5·2²³: adding it rounds to an integer (a·2/π ≤ 5216 here).
+    const MAGIC: f32 = 12_582_912.0;
+    let j = (a * core::f32::consts::FRAC_2_PI + MAGIC) - MAGIC;
+    // PIO2_1 has 8 significant bits, PIO2_2 11, j ≤ 5216 < 2¹³: both products are exact and
+    // so are both differences (multiples of 2⁻²⁴ resp. ulp(a) below 1 resp. 4).
+    let b = (a - j * PIO2_1) - j * PIO2_2;
+    let (p, p_lo) = two_prod(j, PIO2_3);
+    let (y, y_lo) = two_sum(b, -p);
+    let (t, t_lo) = tan_kernel(y, y_lo - p_lo - j * PIO2_4);
+    // j is a small non-negative integer; `as` cannot fail.
+    let t = if (j as u32) & 1 == 1 { -recip(t, t_lo) } else { t + t_lo };
+    // tan is odd; the sign of t is that of tan(|x|).
+    if x < 0.0 {
+        -t
+    } else {
+        t
+    }
+}
+
+/// Below this `|x|` (2⁻¹²) [`tan`] returns x.
+const TAN_TINY: f32 = 2.441_406_25e-4;
+/// Beyond this `|x|` [`tan`] returns NaN (the reduction would need more parts of π/2).
+const TAN_MAX: f32 = 8192.0;
+/// π/2 = PIO2_1 + PIO2_2 + PIO2_3 + PIO2_4 + O(1e-23): 8 and 11 significant bits, then
+/// two f32 roundings of the rest.
+const PIO2_1: f32 = 1.570_312_5;
+const PIO2_2: f32 = 4.837_512_969_970_703e-4;
+const PIO2_3: f32 = 7.549_790_126_404_332e-8;
+const PIO2_4: f32 = -1.715_124_510_005_882e-15;
+/// `h(w) = ((tan √w/√w − 1)/w − 1/3)/w` on `[0, 1.001·(π/4)²]`, Chebyshev fit of degree 6
+/// (mpmath `chebyfit`; absolute error 3.5e-9, 1.1e-9 in `tan`), constant term first.
+const TAN_H: [f32; 7] = [
+    0.133_333_340_287_208_56,
+    0.053_967_837_244_272_23,
+    0.021_880_175_918_340_683,
+    0.008_762_069_977_819_92,
+    0.004_039_282_444_864_511_5,
+    0.000_477_546_680_485_829_7,
+    0.001_559_253_665_618_598_5,
+];
+
+/// `tan(y + y_lo)` for `|y| ≤ π/4` (a little beyond is harmless), `|y_lo| ≤ ulp(y)`, as
+/// an unevaluated sum hi + lo (`|lo| ≤ ulp(hi)`): `y + y³/3 + y⁵·h(y²)`, with `y³` exact
+/// to f32² and `y³/3` correctly rounded, so that the rounding errors left are those of
+/// the `y⁵` term (≤ 6 % of the result).
+#[inline(always)]
+fn tan_kernel(y: f32, y_lo: f32) -> (f32, f32) {
+    let [h0, h1, h2, h3, h4, h5, h6] = TAN_H;
+    let (z, z_lo) = two_prod(y, y);
+    let (w, w_lo) = two_prod(y, z);
+    let w_lo = w_lo + y * z_lo;
+    let c1 = w / 3.0;
+    let h = h0 + z * (h1 + z * (h2 + z * (h3 + z * (h4 + z * (h5 + z * h6)))));
+    let c2 = (w * z) * h;
+    // |y³/3| < |y| with the same sign: y − s is exact (Fast2Sum).
+    let s = y + c1;
+    let lo = ((y - s) + c1) + (c2 + (w_lo / 3.0 + y_lo * (1.0 + s * s)));
+    let hi = s + lo;
+    (hi, (s - hi) + lo)
+}
+
+/// `1/(hi + lo)` for `|lo| ≤ ulp(hi)`, `hi` ≠ 0 and not near the f32 limits: `q = 1/hi`
+/// corrected by its exact residual `1 − q·hi` and by `lo`.
+#[inline(always)]
+fn recip(hi: f32, lo: f32) -> f32 {
+    let q = 1.0 / hi;
+    let (p, p_lo) = two_prod(q, hi);
+    // p is within an ulp of 1: 1 − p is exact (Sterbenz).
+    let e = (1.0 - p) - p_lo;
+    q + q * (e - q * lo)
+}
+
+/// `a + b = s + e` exactly (Knuth's TwoSum; no ordering assumption).
+#[inline(always)]
+fn two_sum(a: f32, b: f32) -> (f32, f32) {
+    let s = a + b;
+    let bb = s - a;
+    (s, (a - (s - bb)) + (b - bb))
+}
+
+/// `a·b = p + e` exactly without FMA (Dekker with Veltkamp's split by 2¹² + 1), barring
+/// overflow and underflow.
+#[inline(always)]
+fn two_prod(a: f32, b: f32) -> (f32, f32) {
+    let split = |v: f32| {
+        let c = 4097.0 * v;
+        let hi = c - (c - v);
+        (hi, v - hi)
+    };
+    let p = a * b;
+    let (ah, al) = split(a);
+    let (bh, bl) = split(b);
+    (p, ((ah * bh - p) + ah * bl + al * bh) + al * bl)
+}
+
 /// `e^{−y}` for `0 ≤ y ≤ 64` without libm (the hot paths of the stateless models): `2^t`
 /// with `t = −y·log₂e` split into a nearest integer n and `f ∈ [−½, ½]`, `2^f = e^{f·ln 2}`
 /// by its Taylor series to the 6th power (relative error ≤ 4e-7 + 8e-8·y, the second

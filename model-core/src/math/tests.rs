@@ -52,3 +52,62 @@ fn symmetric_clamp_limits_and_zeroes_nan() {
     assert_eq!(clamp_symmetric(f32::NAN, 1.0), 0.0);
     assert_eq!(clamp_symmetric(f32::NEG_INFINITY, 2.0), -2.0);
 }
+
+/// Error of an f32 result in units of the last place of the exact value (f64 `tan` is
+/// correct to ~1e-16 relative, far below an f32 ulp).
+fn ulps(got: f32, want: f64) -> f64 {
+    // ulp of the f32 binade holding the exact value: 2^(exponent − 23), at least 2⁻¹⁴⁹.
+    let exponent = ((want.abs().to_bits() >> 52) as i32 - 1023).max(-126);
+    (f64::from(got) - want).abs() / 2f64.powi(exponent - 23)
+}
+
+#[test]
+fn tan_is_within_one_ulp_of_f64_tan_on_the_bouc_wen_range() {
+    // The Riccati leg's argument: [0, π/2) (every 64th f32 there, and every f32 in the last
+    // 2¹⁶ below π/2, where tan grows without bound), and the negated arguments.
+    let top = core::f32::consts::FRAC_PI_2.to_bits() - 1;
+    assert!(f64::from(f32::from_bits(top)) < std::f64::consts::FRAC_PI_2);
+    let bits = (0..top).step_by(64).chain(top - (1 << 16)..=top);
+    let (mut worst, mut worst_at, mut libm_apart) = (0.0f64, 0.0f32, 0u32);
+    for b in bits {
+        let x = f32::from_bits(b);
+        for x in [x, -x] {
+            let got = tan(x);
+            let e = ulps(got, f64::from(x).tan());
+            if e > worst {
+                (worst, worst_at) = (e, x);
+            }
+            libm_apart = libm_apart.max(got.to_bits().abs_diff(libm::tanf(x).to_bits()));
+        }
+    }
+    assert!(worst <= 1.0, "tan: {worst} ulp at {worst_at:e}");
+    // libm's tanf (an f64 evaluation rounded once) is within an ulp too: the two are equal
+    // or neighbours.
+    assert!(libm_apart <= 1, "tan and libm's tanf {libm_apart} ulp apart");
+}
+
+#[test]
+fn tan_is_within_one_ulp_of_f64_tan_up_to_8192_and_nan_beyond() {
+    let mut worst = (0.0f64, 0.0f32);
+    let mut x = core::f32::consts::FRAC_PI_4;
+    while x <= 8192.0 {
+        let e = ulps(tan(x), f64::from(x).tan());
+        if e > worst.0 {
+            worst = (e, x);
+        }
+        x = f32::from_bits(x.to_bits() + 997);
+    }
+    assert!(worst.0 <= 1.0, "tan: {} ulp at {:e}", worst.0, worst.1);
+    // Multiples of π/2 the reduction must resolve (the f32s nearest k·π/2).
+    for k in 1..5000 {
+        let x = (f64::from(k) * std::f64::consts::FRAC_PI_2) as f32;
+        let e = ulps(tan(x), f64::from(x).tan());
+        assert!(e <= 1.0, "tan({x:e}) (k = {k}): {e} ulp");
+    }
+    assert_eq!(tan(0.0).to_bits(), 0.0f32.to_bits());
+    assert_eq!(tan(-0.0).to_bits(), (-0.0f32).to_bits());
+    assert_eq!(tan(1e-30), 1e-30);
+    for x in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 8192.5, -1e30] {
+        assert!(tan(x).is_nan(), "tan({x})");
+    }
+}

@@ -2,7 +2,7 @@
 //! (exponential) and `n = 2` (Riccati: `tanh`/`tan` forms), stopping where `w` reaches 0
 //! (module docs of [`bouc_wen`](super)).
 
-use crate::math::{atan, expm1, sqrt, tanh};
+use crate::math::{atan, expm1, sqrt, tan, tanh};
 
 /// Result of integrating one sign region.
 pub(super) enum Leg {
@@ -61,7 +61,7 @@ pub(super) fn region_n2(v0: f32, l: f32, p: f32, q: f32) -> Leg {
             let rem = l - th / r;
             return Leg::Crossed(if rem > 0.0 { rem } else { 0.0 });
         }
-        let t = libm::tanf(rl);
+        let t = tan(rl);
         let v = s * (v0 - s * t) / (s + v0 * t);
         return Leg::Done(if v > 0.0 { v } else { 0.0 });
     }
