@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use serde::Serialize;
 
-use super::isr::{tree, Interrupts};
+use super::isr::{tree, Interrupts, Masked};
 use super::table::{Budget, CONTROL_HZ, CORE_HZ};
 
 /// Figures of one measured step.
@@ -64,18 +64,14 @@ pub struct Report {
 }
 
 impl Report {
-    /// Steps that miss their budget, with the reasons; and f64 soft-float reachable from a
-    /// firmware interrupt.
+    /// Steps that miss their budget, with the reasons.
     pub fn exceeded(&self) -> Vec<String> {
-        let mut v = self.named(StepFigures::excess);
-        if let Some(i) = &self.interrupts {
-            v.extend(i.warnings());
-        }
-        v
+        self.named(StepFigures::excess)
     }
 
     /// Steps over the ceiling `--check` enforces, with the reasons; and what the firmware's
-    /// interrupts may not do (mask interrupts, step + slow pass beyond a period).
+    /// interrupts may not do (reach an f64 soft-float helper, mask interrupts, step + slow
+    /// pass beyond a period).
     pub fn over_ceiling(&self) -> Vec<String> {
         let mut v = self.named(StepFigures::over_ceiling);
         if let Some(i) = &self.interrupts {
@@ -176,18 +172,24 @@ fn interrupts(r: &Report, i: &Interrupts) -> String {
     }
     if let Some(c) = r.isr_cycles_max() {
         s += &format!(
-            "control interrupt with the slow pass in its tail: <= {c} cycles of {} a period; \
-             slow pass masked stretch: 0 cycles (it runs in the interrupt, which masks nothing)\n",
+            "control interrupt with the slow pass in its tail: <= {c} cycles of {} a period\n",
             (CORE_HZ / CONTROL_HZ) as u64
         );
     }
-    let m = &i.thread_masked;
-    s += &format!(
-        "longest interrupt-masked stretch in thread mode: {} instructions, <= {} cycles ({}{})\n",
+    s += &masked("in the interrupts (the slow pass included)", &i.interrupt_masked);
+    s += &masked("in thread mode", &i.thread_masked);
+    s
+}
+
+fn masked(where_: &str, m: &Masked) -> String {
+    if m.instructions == 0 && m.cycles_max == 0 {
+        return format!("longest interrupt-masked stretch {where_}: 0 cycles (no cpsid)\n");
+    }
+    format!(
+        "longest interrupt-masked stretch {where_}: {} instructions, <= {} cycles ({}{})\n",
         m.instructions,
         m.cycles_max,
         m.function,
         if m.calls.is_empty() { String::new() } else { format!("; calls {}", m.calls.join(", ")) }
-    );
-    s
+    )
 }

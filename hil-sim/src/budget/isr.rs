@@ -1,11 +1,13 @@
 //! The shipping firmware's interrupts as built: the static call graph of each root
 //! (`ADC1_2`, the control interrupt with the slow pass in its tail; `TIM1_UP_TIM16`, the
 //! deadline monitor) from the ELF's disassembly (`llvm-objdump -d -C`), the f64
-//! soft-float helpers reachable from it (reported: `__aeabi_d*` costs 50–150 cycles a
-//! call on the single-precision FPU), and where interrupts are masked (`cpsid i`): none
-//! in the interrupts (the monitor must pre-empt a stuck step), and the longest
-//! straight-line masked stretch anywhere in thread mode, in cycles (upper bound from
-//! [`cycles_of`]; a call inside the stretch is named, its callee's cycles added once).
+//! soft-float helpers reachable from it (none allowed: the M4F's FPU is single precision,
+//! so every f64 operation is a call, `__aeabi_d*` 50–150 cycles each; `--check` fails on
+//! one), and where interrupts are masked (`cpsid i`): none in the interrupts (the monitor
+//! must pre-empt a stuck step), and the longest straight-line masked stretch, in cycles
+//! (upper bound from [`cycles_of`]; a call inside the stretch is named, its callee's
+//! cycles added once), in the interrupts' code (the slow pass runs in the control
+//! interrupt's tail) and anywhere in thread mode.
 //! Panic paths (`core::panicking::*`, …) are leaves: the panic handler masks interrupts on
 //! purpose once the bridge is off, and never returns.
 
@@ -30,13 +32,35 @@ struct Insn {
 /// Functions by name, instructions in address order.
 type Program = BTreeMap<String, Vec<Insn>>;
 
-/// Soft-float f64 helpers of compiler-builtins / the AEABI.
+/// Soft-float f64 helpers of compiler-builtins / the AEABI: every f64 operation on a
+/// single-precision FPU (arithmetic, comparison, conversion from or to f64).
+/// - AEABI (ARM IHI 0043): `__aeabi_d…` (`dadd`, `dmul`, `dcmpeq`, `d2f`, `d2iz`, …),
+///   `__aeabi_cd…` (`cdcmple`, …) and the conversions to f64 `__aeabi_{f,i,ui,l,ul}2d`;
+/// - libgcc / compiler-builtins names with the `df` (f64) mode: `__adddf3`, `__eqdf2`,
+///   `__extendsfdf2`, `__truncdfsf2`, `__fixdfsi`, `__floatsidf`, `__powidf2`, …
+///
+/// A demangled path (`compiler_builtins::float::mul::__muldf3`) is judged by its last part.
 pub fn is_f64_helper(name: &str) -> bool {
-    name.starts_with("__aeabi_d")
-        || name.starts_with("__aeabi_f2d")
-        || ["adddf3", "subdf3", "muldf3", "divdf3", "extendsfdf2", "truncdfsf2", "floatsidf", "fixdfsi"]
-            .iter()
-            .any(|h| name.contains(h))
+    let last = name.rsplit("::").find(|seg| !is_hash(seg)).unwrap_or(name);
+    if let Some(a) = last.strip_prefix("__aeabi_") {
+        return a.starts_with('d') && !a.starts_with("div")
+            || a.starts_with("cd")
+            || ["f2d", "i2d", "ui2d", "l2d", "ul2d"].contains(&a);
+    }
+    let Some(g) = last.strip_prefix("__") else { return false };
+    // `<op>df2`/`<op>df3` (arithmetic, comparisons, powi), `…sfdf2`/`…dfsf2` (f32 ↔ f64),
+    // `fix[uns]df{si,di,ti}` and `float[un]{si,di,ti}df` (integers ↔ f64).
+    let int_modes = ["si", "di", "ti"];
+    g.ends_with("df2")
+        || g.ends_with("df3")
+        || g.contains("dfsf")
+        || (g.starts_with("fix") && int_modes.iter().any(|m| g.ends_with(&format!("df{m}"))))
+        || (g.starts_with("float") && int_modes.iter().any(|m| g.ends_with(&format!("{m}df"))))
+}
+
+/// The `h0123456789abcdef` hash part of a demangled legacy Rust symbol.
+fn is_hash(seg: &str) -> bool {
+    seg.len() == 17 && seg.starts_with('h') && seg.bytes().skip(1).all(|b| b.is_ascii_hexdigit())
 }
 
 /// One interrupt's call graph.
@@ -45,7 +69,7 @@ pub struct Root {
     pub name: String,
     /// Reachable functions with their direct callees (sorted).
     pub call_graph: Vec<(String, Vec<String>)>,
-    /// Reachable f64 soft-float helpers (reported as a warning).
+    /// Reachable f64 soft-float helpers (must be empty).
     pub f64_soft_float: Vec<String>,
     /// Reachable functions that execute `cpsid i` (must be empty).
     pub masking: Vec<String>,
@@ -66,30 +90,27 @@ pub struct Masked {
 #[derive(Clone, Debug, Serialize)]
 pub struct Interrupts {
     pub roots: Vec<Root>,
+    /// The longest masked stretch in the code the interrupts reach (the control
+    /// interrupt's includes the slow pass); empty (0 cycles) when none masks.
+    pub interrupt_masked: Masked,
     /// Thread mode's longest masked stretch.
     pub thread_masked: Masked,
 }
 
 impl Interrupts {
-    /// What `--check` refuses: masking in an interrupt.
+    /// What `--check` refuses: an f64 soft-float helper reachable from an interrupt, or
+    /// masking in one.
     pub fn violations(&self) -> Vec<String> {
         let mut v = Vec::new();
         for r in &self.roots {
+            if !r.f64_soft_float.is_empty() {
+                v.push(format!("{}: f64 soft-float reachable: {}", r.name, r.f64_soft_float.join(", ")));
+            }
             if !r.masking.is_empty() {
                 v.push(format!("{}: masks interrupts in {}", r.name, r.masking.join(", ")));
             }
         }
         v
-    }
-
-    /// What is reported as a warning: f64 soft-float helpers reachable from an interrupt
-    /// (cycles, not correctness: they are measured in the step budgets).
-    pub fn warnings(&self) -> Vec<String> {
-        self.roots
-            .iter()
-            .filter(|r| !r.f64_soft_float.is_empty())
-            .map(|r| format!("{}: f64 soft-float reachable: {}", r.name, r.f64_soft_float.join(", ")))
-            .collect()
     }
 }
 
@@ -183,9 +204,10 @@ fn straight_cycles(p: &Program, f: &str) -> u64 {
     p.get(f).map_or(0, |v| v.iter().map(|i| u64::from(cycles_of(&i.mnemonic, &i.operands).max)).sum())
 }
 
-fn thread_masked(p: &Program, interrupt_code: &BTreeSet<String>) -> Masked {
+/// The longest straight-line stretch after a `cpsid` in the functions `within` selects.
+fn longest_masked(p: &Program, within: impl Fn(&str) -> bool) -> Masked {
     let mut best = Masked::default();
-    for (f, insns) in p.iter().filter(|(f, _)| !interrupt_code.contains(*f)) {
+    for (f, insns) in p.iter().filter(|(f, _)| within(f)) {
         for (k, _) in insns.iter().enumerate().filter(|(_, i)| i.mnemonic == "cpsid") {
             let mut m = Masked { function: f.clone(), ..Masked::default() };
             for i in insns.iter().skip(k + 1) {
@@ -236,7 +258,11 @@ pub fn analyse(objdump: &Path, elf: &Path) -> Result<Interrupts, BudgetError> {
         .collect::<Result<_, _>>()?;
     let in_interrupts: BTreeSet<String> =
         roots.iter().flat_map(|r| r.call_graph.iter().map(|(f, _)| f.clone())).collect();
-    Ok(Interrupts { roots, thread_masked: thread_masked(&p, &in_interrupts) })
+    Ok(Interrupts {
+        interrupt_masked: longest_masked(&p, |f| in_interrupts.contains(f) && !is_panic_entry(f)),
+        thread_masked: longest_masked(&p, |f| !in_interrupts.contains(f)),
+        roots,
+    })
 }
 
 /// The call graph as an indented tree (each function once, at its first appearance).
@@ -277,6 +303,9 @@ mod tests {
 08000400 <__aeabi_dmul>:
  8000400:      \tbx\tlr
 
+08000480 <TIM1_UP_TIM16>:
+ 8000480:      \tbx\tlr
+
 08000500 <thread>:
  8000500:      \tcpsid i
  8000502:      \tldr\tr0, [r1]
@@ -297,8 +326,89 @@ mod tests {
     #[test]
     fn masked_stretch_counts_the_instructions_between() {
         let p = parse(DIS);
-        let m = thread_masked(&p, &BTreeSet::new());
+        let m = longest_masked(&p, |_| true);
         assert_eq!((m.function.as_str(), m.instructions), ("thread", 2));
         assert!(m.cycles_max >= 2);
+        // The interrupt's own code masks nothing.
+        let r = root(&p, "ADC1_2");
+        let m = longest_masked(&p, |f| r.call_graph.iter().any(|(g, _)| g == f));
+        assert_eq!((m.instructions, m.cycles_max), (0, 0));
+    }
+
+    #[test]
+    fn an_f64_helper_in_an_interrupt_is_a_violation() {
+        let p = parse(DIS);
+        let i = Interrupts {
+            roots: vec![root(&p, "ADC1_2")],
+            interrupt_masked: Masked::default(),
+            thread_masked: Masked::default(),
+        };
+        assert_eq!(i.violations(), vec!["ADC1_2: f64 soft-float reachable: __aeabi_dmul".to_owned()]);
+        let clean = Interrupts { roots: vec![root(&p, "TIM1_UP_TIM16")], ..i };
+        assert!(clean.violations().is_empty(), "{:?}", clean.violations());
+    }
+
+    #[test]
+    fn every_f64_helper_name_is_recognised() {
+        let f64_helpers = [
+            "__aeabi_dadd",
+            "__aeabi_ddiv",
+            "__aeabi_dmul",
+            "__aeabi_drsub",
+            "__aeabi_dsub",
+            "__aeabi_dneg",
+            "__aeabi_dcmpeq",
+            "__aeabi_dcmpun",
+            "__aeabi_cdcmple",
+            "__aeabi_cdrcmple",
+            "__aeabi_d2f",
+            "__aeabi_d2iz",
+            "__aeabi_d2uiz",
+            "__aeabi_d2lz",
+            "__aeabi_d2ulz",
+            "__aeabi_f2d",
+            "__aeabi_i2d",
+            "__aeabi_ui2d",
+            "__aeabi_l2d",
+            "__aeabi_ul2d",
+            "compiler_builtins::float::add::__adddf3",
+            "compiler_builtins::float::div::__divdf3",
+            "__muldf3",
+            "__subdf3",
+            "__negdf2",
+            "__eqdf2",
+            "__unorddf2",
+            "__powidf2",
+            "__extendsfdf2",
+            "__truncdfsf2",
+            "__fixdfsi",
+            "__fixunsdfdi",
+            "__floatsidf",
+            "__floatundidf",
+        ];
+        for h in f64_helpers {
+            assert!(is_f64_helper(h), "{h}");
+        }
+        let not_f64 = [
+            "__aeabi_fadd",
+            "__aeabi_fmul",
+            "__aeabi_f2iz",
+            "__aeabi_i2f",
+            "__aeabi_memcpy4",
+            "__aeabi_memclr8",
+            "__aeabi_uidiv",
+            "__aeabi_idivmod",
+            "__aeabi_ldivmod",
+            "__addsf3",
+            "__floatsisf",
+            "__udivdi3",
+            "compiler_builtins::mem::memcpy",
+            "libm::math::tanf::tanf::h3508fa608e849d83",
+            "model_core::math::tan::h0123456789abcdef",
+            "_defmt_acquire",
+        ];
+        for h in not_f64 {
+            assert!(!is_f64_helper(h), "{h}");
+        }
     }
 }

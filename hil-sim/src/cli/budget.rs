@@ -71,7 +71,8 @@ pub fn run(a: BudgetArgs) -> anyhow::Result<()> {
                     "indirect_calls": r.indirect_calls,
                 })).collect::<Vec<_>>(),
                 "isr_with_slow_pass_cycles_max": report.isr_cycles_max(),
-                "slow_pass_masked_cycles": 0,
+                "slow_pass_masked_cycles": i.interrupt_masked.cycles_max,
+                "interrupt_masked": i.interrupt_masked,
                 "thread_masked": i.thread_masked,
             })),
         }))?;
