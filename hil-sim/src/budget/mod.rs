@@ -26,9 +26,9 @@
 //! that exceeds one.
 //!
 //! The shipping firmware ELF, built beside the bench, is read statically ([`isr`]): the
-//! control interrupt's call graph as built (f64 soft-float helpers reachable from it are
-//! reported; it may not mask interrupts: the deadline monitor must pre-empt it), and the longest
-//! interrupt-masked stretch left in thread mode. The slow supervisor pass runs in the
+//! control interrupt's call graph as built (no f64 soft-float helper may be reachable from
+//! it, and it may not mask interrupts: the deadline monitor must pre-empt it), and the
+//! longest interrupt-masked stretch in the interrupts' code and in thread mode. The slow supervisor pass runs in the
 //! control interrupt's tail (after the compare write), so the interrupt's worst case is
 //! `control_step` + `supervisor_slow`, checked against one control period.
 //!
