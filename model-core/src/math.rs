@@ -56,7 +56,7 @@ pub fn tan(x: f32) -> f32 {
         let (t, t_lo) = tan_kernel(x, 0.0);
         return t + t_lo;
     }
-    if !(a <= TAN_MAX) {
+    if a.is_nan() || a > TAN_MAX {
         return f32::NAN;
     }
     // 1.5·2²³: adding it rounds to an integer (a·2/π ≤ 5216 here).
@@ -79,26 +79,19 @@ pub fn tan(x: f32) -> f32 {
 }
 
 /// Below this `|x|` (2⁻¹²) [`tan`] returns x.
-const TAN_TINY: f32 = 2.441_406_25e-4;
+const TAN_TINY: f32 = 1.0 / 4096.0;
 /// Beyond this `|x|` [`tan`] returns NaN (the reduction would need more parts of π/2).
 const TAN_MAX: f32 = 8192.0;
 /// π/2 = PIO2_1 + PIO2_2 + PIO2_3 + PIO2_4 + O(1e-23): 8 and 11 significant bits, then
 /// two f32 roundings of the rest.
 const PIO2_1: f32 = 1.570_312_5;
-const PIO2_2: f32 = 4.837_512_969_970_703e-4;
-const PIO2_3: f32 = 7.549_790_126_404_332e-8;
-const PIO2_4: f32 = -1.715_124_510_005_882e-15;
+const PIO2_2: f32 = 0.000_483_751_3;
+const PIO2_3: f32 = 7.549_79e-8;
+const PIO2_4: f32 = -1.715_124_5e-15;
 /// `h(w) = ((tan √w/√w − 1)/w − 1/3)/w` on `[0, 1.001·(π/4)²]`, Chebyshev fit of degree 6
 /// (mpmath `chebyfit`; absolute error 3.5e-9, 1.1e-9 in `tan`), constant term first.
-const TAN_H: [f32; 7] = [
-    0.133_333_340_287_208_56,
-    0.053_967_837_244_272_23,
-    0.021_880_175_918_340_683,
-    0.008_762_069_977_819_92,
-    0.004_039_282_444_864_511_5,
-    0.000_477_546_680_485_829_7,
-    0.001_559_253_665_618_598_5,
-];
+const TAN_H: [f32; 7] =
+    [0.133_333_34, 0.053_967_837, 0.021_880_176, 0.008_762_07, 0.004_039_282_4, 0.000_477_546_68, 0.001_559_253_7];
 
 /// `tan(y + y_lo)` for `|y| ≤ π/4` (a little beyond is harmless), `|y_lo| ≤ ulp(y)`, as
 /// an unevaluated sum hi + lo (`|lo| ≤ ulp(hi)`): `y + y³/3 + y⁵·h(y²)`, with `y³` exact
