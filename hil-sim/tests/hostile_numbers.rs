@@ -80,6 +80,11 @@ fn a_loop_duration_that_scores_nothing_is_refused() {
     }
     let r = hil_sim(&["loop", "--scenario", "multisine", "--control-hz=0"]);
     refused(&r, &["control"]);
+    // A duration the scenario would not use is refused, not ignored.
+    for scenario in ["steps", "sweep", "heating", "faults"] {
+        let r = hil_sim(&["loop", "--scenario", scenario, "--duration=8e11"]);
+        refused(&r, &["--duration", "multisine only", scenario]);
+    }
 }
 
 #[test]

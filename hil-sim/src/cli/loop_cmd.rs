@@ -36,6 +36,9 @@ impl From<LoopScenarioArg> for LoopScenario {
     }
 }
 
+/// `--duration`'s default for the multisine run, s.
+const DEFAULT_MULTISINE_S: f64 = 20.0;
+
 #[derive(Args, Debug)]
 pub struct LoopArgs {
     #[arg(long, value_enum)]
@@ -49,9 +52,9 @@ pub struct LoopArgs {
     /// Control-step rate, Hz.
     #[arg(long, default_value_t = 10_000.0)]
     pub control_hz: f64,
-    /// Duration of the multisine run, s.
-    #[arg(long, default_value_t = 20.0)]
-    pub duration: f64,
+    /// Duration of the multisine run, s (default 20; the other scenarios have fixed lengths).
+    #[arg(long)]
+    pub duration: Option<f64>,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     #[arg(long)]
@@ -72,7 +75,15 @@ pub fn run_cmd(a: LoopArgs) -> anyhow::Result<()> {
         }
         None => ClutchParams::default(),
     };
-    let spec = LoopSpec { scenario: a.scenario.into(), control_hz: a.control_hz, duration: a.duration, seed: a.seed };
+    let scenario: LoopScenario = a.scenario.into();
+    let duration = match (a.duration, scenario) {
+        (None, _) => DEFAULT_MULTISINE_S,
+        (Some(d), LoopScenario::Multisine) => d,
+        (Some(_), other) => {
+            anyhow::bail!("--duration applies to --scenario multisine only; `{}` has a fixed length", other.name())
+        }
+    };
+    let spec = LoopSpec { scenario, control_hz: a.control_hz, duration, seed: a.seed };
     let bar = super::progress::Bar::new(3, "identify");
     let report = evaluate(&clutch, &spec, &bar)?;
     bar.finish();

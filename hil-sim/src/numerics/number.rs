@@ -36,6 +36,20 @@ pub fn with_unit(v: f64, sig: usize, unit: &str) -> String {
     }
 }
 
+/// `v` with a sign and `decimals` decimals (`"+1.997"`, `"-0.491"`), and `"+0.000"` rather
+/// than `"-0.000"` when `v` rounds to zero; `"—"` for NaN or infinity.
+pub fn signed(v: f64, decimals: usize) -> String {
+    if !v.is_finite() {
+        return "—".into();
+    }
+    let s = format!("{v:+.decimals$}");
+    if s[1..].chars().all(|c| c == '0' || c == '.') {
+        format!("+{}", &s[1..])
+    } else {
+        s
+    }
+}
+
 fn superscript(e: i32) -> String {
     const DIGITS: [char; 10] = ['⁰', '¹', '²', '³', '⁴', '⁵', '⁶', '⁷', '⁸', '⁹'];
     let mut s = String::new();
@@ -67,5 +81,15 @@ mod tests {
         assert_eq!(with_unit(6.1e-3, 2, "s"), "0.0061 s");
         assert_eq!(with_unit(2.0, 2, ""), "2.0");
         assert!(!num(1e300, 3).contains('e'));
+    }
+
+    #[test]
+    fn signed_never_shows_minus_zero() {
+        assert_eq!(signed(1.9971, 3), "+1.997");
+        assert_eq!(signed(-0.4911, 3), "-0.491");
+        assert_eq!(signed(-0.0002, 3), "+0.000");
+        assert_eq!(signed(-0.0, 2), "+0.00");
+        assert_eq!(signed(-0.0006, 3), "-0.001");
+        assert_eq!(signed(f64::INFINITY, 3), "—");
     }
 }

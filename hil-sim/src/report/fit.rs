@@ -9,7 +9,7 @@ use model_core::control::page::RateSpec;
 use super::plot::{self, colour, PlotError, Series, Style};
 use super::Report;
 use crate::ident::fit::{Dataset, FitResult};
-use crate::numerics::number::num;
+use crate::numerics::number::{num, signed};
 
 /// Axis labels with units, e.g. `("D (cm)", "F (N)")`.
 #[derive(Clone, Debug)]
@@ -125,7 +125,7 @@ pub fn fit_plots(
     let x_label = if r.delay_s == 0.0 {
         labels.input.clone()
     } else {
-        format!("{} at t {:+.2} ms (fitted delay)", labels.input, 1e3 * r.delay_s)
+        format!("{} at t {} ms (fitted delay)", labels.input, signed(1e3 * r.delay_s, 2))
     };
     plot::hysteresis_loop(
         dir.join(&name),
@@ -234,7 +234,7 @@ pub fn results_table(report: &mut Report, results: &[FitResult], labels: &Labels
                 row.push(describe_rate(&r.rate_choice, labels.input_unit()));
             }
             row.extend([
-                format!("{:+.3} / {:+.3}", 1e3 * r.delay_s, 1e3 * r.command_delay_s),
+                format!("{} / {}", signed(1e3 * r.delay_s, 3), signed(1e3 * r.command_delay_s, 3)),
                 num(r.train.rmse, 4),
                 format!("{:.4}", r.train.r2),
                 num(r.heldout.rmse, 4),
