@@ -33,7 +33,6 @@ pub mod simulate;
 
 use std::time::Instant;
 
-use rayon::prelude::*;
 use serde::Serialize;
 use thiserror::Error;
 
@@ -514,6 +513,8 @@ fn identify(
             let window_rows: Vec<usize> = rows.iter().copied().filter(|&i| i < opts.swarm_window).collect();
             let window_rows = if window_rows.len() < 20 { rows.to_vec() } else { window_rows };
             let win = Objective::new(sim, sp, kin, y, &window_rows, y_scale);
+            // The papers' start, polished on the window: the same in every start.
+            let polished_start = std::sync::OnceLock::new();
             let mut evals = 0;
             let mut failure = None;
             let best = restarts::until_agree(
@@ -523,12 +524,12 @@ fn identify(
                 notes,
                 |seed| {
                     let swarm = SwarmOptions { seed, ..opts.swarm };
-                    let r = global_search(id, sp, &win, &full, opts, swarm).and_then(|first| match first {
+                    let search = |swarm| global::global_search(id, sp, (&win, &full), opts, swarm, &polished_start);
+                    let r = search(swarm).and_then(|first| match first {
                         (Some(best), e) => Ok((Some(best), e)),
                         // A box where the small swarm found nothing valid (a start that is not a
                         // published set, a narrow valid region) gets a wider search before giving up.
-                        (None, e) => global_search(id, sp, &win, &full, opts, SwarmOptions::wide(seed))
-                            .map(|(b, more)| (b, e + more)),
+                        (None, e) => search(SwarmOptions::wide(seed)).map(|(b, more)| (b, e + more)),
                     });
                     match r {
                         Ok((b, e)) => {
@@ -553,42 +554,6 @@ fn identify(
             valid_or_err(id, sim, r.params, evals)
         }
     }
-}
-
-/// The global phase of [`Strategy::Global`]: swarm on the window, then every candidate and
-/// the papers' start polished there. Returns the candidate with the lowest cost on the whole
-/// training part (`None` when none is valid) and the evaluations spent.
-fn global_search(
-    id: &str,
-    sp: &ModelSpec,
-    win: &Objective<'_>,
-    full: &Objective<'_>,
-    opts: &FitOptions,
-    swarm: SwarmOptions,
-) -> Result<(Option<lm::LocalFit>, usize), FitError> {
-    let mut cands =
-        global::search(win, swarm).map_err(|e| FitError::Swarm { model: id.to_owned(), reason: e.to_string() })?;
-    // The papers' starting values are always polished too: they are often in the
-    // right basin already (Spencer's published set on the Dyke files is), and the
-    // swarm offers the alternatives.
-    let start = sp.start();
-    if !cands.iter().any(|c| c.params == start) {
-        cands.push(global::Candidate { cost: win.cost(&start), params: start });
-    }
-    // Polish every candidate on the window (in parallel), rank them by their cost on
-    // the whole training part (one run each: the window alone does not tell
-    // near-equal basins apart), then finish the best on the whole training part.
-    let polished: Vec<lm::LocalFit> = cands
-        .par_iter()
-        .map(|c| {
-            let r = lm::minimize(win, &c.params, opts.polish_iterations);
-            lm::LocalFit { cost: full.cost(&r.params), evaluations: r.evaluations + 1, ..r }
-        })
-        .collect();
-    let evals =
-        swarm.particles * (swarm.iterations as usize + 1) + polished.iter().map(|r| r.evaluations).sum::<usize>();
-    let best = polished.into_iter().filter(|r| r.cost.is_finite()).min_by(|a, b| a.cost.total_cmp(&b.cost));
-    Ok((best, evals))
 }
 
 fn valid_or_err(
