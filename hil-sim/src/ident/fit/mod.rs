@@ -513,8 +513,7 @@ fn identify(
             let window_rows: Vec<usize> = rows.iter().copied().filter(|&i| i < opts.swarm_window).collect();
             let window_rows = if window_rows.len() < 20 { rows.to_vec() } else { window_rows };
             let win = Objective::new(sim, sp, kin, y, &window_rows, y_scale);
-            // The papers' start, polished on the window: the same in every start.
-            let polished_start = std::sync::OnceLock::new();
+            let polished_start = std::sync::OnceLock::new(); // the papers' start polished: the same every restart
             let mut evals = 0;
             let mut failure = None;
             let best = restarts::until_agree(
