@@ -26,6 +26,15 @@ pub fn symmetrize(gram: &mut DMatrix<f64>) {
 
 /// Normal equations `AᵀA`, `Aᵀb` of the columns `cols` at the rows `rows` (`b = y`).
 pub fn normal_equations(cols: &[Vec<f64>], y: &[f64], rows: &[usize]) -> (DMatrix<f64>, DVector<f64>) {
+    // The few-column systems of the projected fits (run once per model evaluation) on the
+    // stack: the same sums in the same order, so the same numbers.
+    match cols.len() {
+        1 => return normal_equations_n::<1>(cols, y, rows),
+        2 => return normal_equations_n::<2>(cols, y, rows),
+        3 => return normal_equations_n::<3>(cols, y, rows),
+        4 => return normal_equations_n::<4>(cols, y, rows),
+        _ => {}
+    }
     let n = cols.len();
     let mut gram = DMatrix::<f64>::zeros(n, n);
     let mut atb = DVector::<f64>::zeros(n);
@@ -39,6 +48,26 @@ pub fn normal_equations(cols: &[Vec<f64>], y: &[f64], rows: &[usize]) -> (DMatri
     }
     symmetrize(&mut gram);
     (gram, atb)
+}
+
+/// [`normal_equations`] for `N` columns (`cols.len() == N`).
+fn normal_equations_n<const N: usize>(cols: &[Vec<f64>], y: &[f64], rows: &[usize]) -> (DMatrix<f64>, DVector<f64>) {
+    let c: [&[f64]; N] = std::array::from_fn(|k| cols.get(k).map_or(&[][..], |v| v.as_slice()));
+    let len = c.iter().map(|v| v.len()).min().unwrap_or(0);
+    let mut g = [[0.0f64; N]; N];
+    let mut atb = [0.0f64; N];
+    for &i in rows {
+        let (Some(&yi), true) = (y.get(i), i < len) else { continue };
+        let a: [f64; N] = std::array::from_fn(|k| c[k][i]);
+        for r in 0..N {
+            atb[r] += a[r] * yi;
+            for k in 0..=r {
+                g[r][k] += a[r] * a[k];
+            }
+        }
+    }
+    let gram = DMatrix::from_fn(N, N, |r, k| if k <= r { g[r][k] } else { g[k][r] });
+    (gram, DVector::from_row_slice(&atb))
 }
 
 /// Fit `y ≈ X·θ` for rows of `N` columns (the lab's small fits): the normal equations

@@ -65,29 +65,6 @@ pub fn warning(names: &[&str], unresolved: &[Unresolved]) -> Option<String> {
     ))
 }
 
-/// [`spanning_zero`] and [`warning`] for a fitted model: `params` (the model's own, no delay
-/// entries) on the kinematics `kin` shifted by the fitted `delays` (samples) within each run.
-#[allow(clippy::too_many_arguments)]
-pub fn check(
-    sim: &dyn super::simulate::Simulator,
-    sp: &crate::models::search::ModelSpec,
-    kin: &[model_core::Kin],
-    y: &[f64],
-    rows: &[usize],
-    scale: f64,
-    delays: (f64, f64),
-    starts: &[usize],
-    params: &[f64],
-) -> Option<String> {
-    let mut shifted = Vec::new();
-    crate::models::alignment::shift_kin_runs(kin, delays.0, delays.1, starts, &mut shifted);
-    let mut spec = sp.clone();
-    spec.params.truncate(sim.n_params());
-    let obj = Objective::new(sim, &spec, &shifted, y, rows, scale);
-    let names: Vec<&str> = spec.params.iter().map(|p| p.name).collect();
-    warning(&names, &spanning_zero(&obj, params))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,6 +12,8 @@ use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
 use super::objective::Objective;
+use super::{lm, FitError, FitOptions};
+use crate::models::search::ModelSpec;
 
 /// Size of the swarm search.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -119,4 +121,45 @@ pub fn search(obj: &Objective<'_>, opts: SwarmOptions) -> Result<Vec<Candidate>,
         .run()?;
     let best = best.into_inner().map_err(|_| Error::msg("swarm bookkeeping poisoned"))?;
     Ok(best.into_iter().map(|(c, u)| Candidate { params: obj.from_unit(&u), cost: c }).collect())
+}
+
+/// The global phase of [`Strategy::Global`]: swarm on the window, then every candidate and
+/// the papers' start polished there (the start once per fit: `polished_start` keeps it for
+/// the other starts of [`super::restarts::until_agree`]). Returns the candidate with the lowest cost
+/// on the whole training part (`None` when none is valid) and the evaluations spent.
+pub(super) fn global_search(
+    id: &str,
+    sp: &ModelSpec,
+    (win, full): (&Objective<'_>, &Objective<'_>),
+    opts: &FitOptions,
+    swarm: SwarmOptions,
+    polished_start: &std::sync::OnceLock<lm::LocalFit>,
+) -> Result<(Option<lm::LocalFit>, usize), FitError> {
+    let mut cands = search(win, swarm).map_err(|e| FitError::Swarm { model: id.to_owned(), reason: e.to_string() })?;
+    // The papers' starting values are always polished too: they are often in the
+    // right basin already (Spencer's published set on the Dyke files is), and the
+    // swarm offers the alternatives.
+    let start = sp.start();
+    if !cands.iter().any(|c| c.params == start) {
+        cands.push(Candidate { cost: win.cost(&start), params: start.clone() });
+    }
+    // Polish every candidate on the window (in parallel), rank them by their cost on
+    // the whole training part (one run each: the window alone does not tell
+    // near-equal basins apart), then finish the best on the whole training part.
+    let polish = |p: &[f64]| {
+        let r = lm::minimize(win, p, opts.polish_iterations);
+        lm::LocalFit { cost: full.cost(&r.params), evaluations: r.evaluations + 1, ..r }
+    };
+    let polished: Vec<lm::LocalFit> = cands
+        .par_iter()
+        .map(|c| match (c.params == start, polished_start.get()) {
+            (true, Some(done)) => lm::LocalFit { evaluations: 0, ..done.clone() },
+            (true, None) => polished_start.get_or_init(|| polish(&start)).clone(),
+            (false, _) => polish(&c.params),
+        })
+        .collect();
+    let evals =
+        swarm.particles * (swarm.iterations as usize + 1) + polished.iter().map(|r| r.evaluations).sum::<usize>();
+    let best = polished.into_iter().filter(|r| r.cost.is_finite()).min_by(|a, b| a.cost.total_cmp(&b.cost));
+    Ok((best, evals))
 }

@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use rayon::prelude::*;
 use thiserror::Error;
 
 use super::{fit, FitError, FitOptions, FitResult};
@@ -67,6 +68,8 @@ pub enum FitJobError {
 }
 
 /// Fit each model in `ids` on `data`, one progress step per model; results in the order of `ids`.
+/// The models are fitted side by side (each fit is deterministic on its own, so the results
+/// are those of fitting them one after another); the first error in the order of `ids` is returned.
 pub fn fit_many(
     data: &crate::ident::dataset::Dataset,
     ids: &[String],
@@ -74,15 +77,17 @@ pub fn fit_many(
     progress: &dyn Progress,
 ) -> Result<Vec<FitResult>, FitJobError> {
     progress.stage("fitting", ids.len() as u64);
-    let mut out = Vec::with_capacity(ids.len());
-    for id in ids {
-        progress.message(id);
-        out.push(
-            fit(id, data, opts).map_err(|source| FitJobError::Fit { model: id.clone(), source: Box::new(source) })?,
-        );
-        progress.advance(1);
-    }
-    Ok(out)
+    let out: Vec<Result<FitResult, FitJobError>> = ids
+        .par_iter()
+        .map(|id| {
+            progress.message(id);
+            let r =
+                fit(id, data, opts).map_err(|source| FitJobError::Fit { model: id.clone(), source: Box::new(source) });
+            progress.advance(1);
+            r
+        })
+        .collect();
+    out.into_iter().collect()
 }
 
 /// Run the job: prepare the recording, fit, save.

@@ -16,7 +16,9 @@
 //!   from a replay through [`crate::models::replay()`] — the `Estimator` path, f32.
 
 pub mod confidence;
+mod delays;
 pub mod global;
+pub mod hold;
 pub mod identifiable;
 pub mod job;
 pub mod linear;
@@ -31,7 +33,6 @@ pub mod simulate;
 
 use std::time::Instant;
 
-use rayon::prelude::*;
 use serde::Serialize;
 use thiserror::Error;
 
@@ -43,6 +44,7 @@ use crate::numerics::metrics::{metrics, Metrics};
 use global::SwarmOptions;
 
 pub use crate::ident::dataset::{Dataset, DatasetError};
+use delays::{as_seen, scan_delay};
 use objective::Objective;
 use per_run::per_run_metrics;
 pub use per_run::RunMetrics;
@@ -166,6 +168,9 @@ pub struct FitResult {
     /// asymmetric Bouc–Wen model, seed 004 on eq. 30).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
+    /// Parameters the data cannot tell from zero, held at zero ([`hold`]), by name.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub held_params: Vec<String>,
     /// Flat parameter vector (registry order).
     #[serde(skip)]
     pub flat: Vec<f64>,
@@ -177,14 +182,15 @@ pub struct FitResult {
 }
 
 /// Fit model `id` to `data`. A fitted delay that ends at the edge of its search range is
-/// held at zero and the model refitted, with a warning ([`identifiable`]).
+/// held at zero and the model refitted, with a warning ([`identifiable`]); so is a parameter
+/// whose confidence interval spans zero, when holding it costs little ([`hold`]).
 pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, FitError> {
-    let first = fit_once(id, data, opts)?;
+    let first = search(id, data, opts)?;
     let dt = data.dt;
-    let (d, d_u) = (first.delay_s / dt, first.command_delay_s / dt);
+    let (d, d_u) = first.delays;
     let (edge_x, edge_u) = (identifiable::at_edge(d), identifiable::at_edge(d_u));
     if opts.delay != DelayChoice::Auto || !(edge_x || edge_u) {
-        return Ok(first);
+        return finish(id, data, opts, first, None);
     }
     let mut which = Vec::new();
     if edge_x {
@@ -193,18 +199,34 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     if edge_u {
         which.push(("command", d_u));
     }
-    let held =
-        DelayChoice::Fixed(if edge_x { 0.0 } else { first.delay_s }, if edge_u { 0.0 } else { first.command_delay_s });
-    let mut r = fit_once(id, data, &FitOptions { delay: held, ..*opts })?;
-    r.warnings.insert(0, identifiable::edge_warning(&which, dt));
-    r.fit_seconds += first.fit_seconds;
+    // The first search is not finished (scored, checked): its delays are discarded.
+    let held = DelayChoice::Fixed(if edge_x { 0.0 } else { d * dt }, if edge_u { 0.0 } else { d_u * dt });
+    let mut r = search(id, data, &FitOptions { delay: held, ..*opts })?;
+    r.seconds += first.seconds;
     r.evaluations += first.evaluations;
-    Ok(r)
+    finish(id, data, opts, r, Some(identifiable::edge_warning(&which, dt)))
 }
 
-/// [`fit`] without the check of the delays.
-fn fit_once(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, FitError> {
-    let info = model_core::registry::find(id).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
+/// What [`search`] found, for [`finish`] to check and score.
+struct Searched {
+    sp: ModelSpec,
+    scales: Scales,
+    sim: Box<dyn simulate::Simulator>,
+    samples: Vec<model_core::Sample>,
+    starts: Vec<usize>,
+    kin: Vec<model_core::Kin>,
+    rows: Vec<usize>,
+    constant_u: Option<f64>,
+    /// The model's parameters (no delay entries), the evaluations spent, the delays (samples).
+    params: Vec<f64>,
+    evaluations: usize,
+    delays: (f64, f64),
+    notes: Vec<String>,
+    seconds: f64,
+}
+
+/// The search of [`fit`] under `opts.delay`, without the checks and the scores.
+fn search(id: &str, data: &Dataset, opts: &FitOptions) -> Result<Searched, FitError> {
     // A command that never changes cannot identify the terms it drives: fit the model's
     // no-command form (those terms held) and say so.
     let constant_u = identifiable::constant_command(data);
@@ -224,7 +246,7 @@ fn fit_once(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fi
         identify_variants(id, sp, sim.as_ref(), kin, &data.output, &rows, &scales, opts, &notes)
     };
     let n_model = sim.n_params();
-    let ((mut params, evaluations), (delay, delay_u)) = match (opts.delay, sp.strategy) {
+    let ((mut params, evaluations), delays) = match (opts.delay, sp.strategy) {
         (DelayChoice::Off, _) => (fit_at(&kin, &sp)?, (0.0, 0.0)),
         (DelayChoice::Fixed(s, s_u), _) => {
             let d = (s / data.dt, if data.command.is_some() { s_u / data.dt } else { 0.0 });
@@ -255,26 +277,67 @@ fn fit_once(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fi
         }
     };
     params.truncate(n_model);
-    let fit_seconds = started.elapsed().as_secs_f64();
-    let mut warnings: Vec<String> = identifiable::constant_command_note(id, data, constant_u).into_iter().collect();
-    warnings.extend(notes.into_inner().unwrap_or_default());
+    let notes = notes.into_inner().unwrap_or_default();
+    let seconds = started.elapsed().as_secs_f64();
+    Ok(Searched {
+        sp,
+        scales,
+        sim,
+        samples,
+        starts,
+        kin,
+        rows,
+        constant_u,
+        params,
+        evaluations,
+        delays,
+        notes,
+        seconds,
+    })
+}
+
+/// Check what [`search`] found (what the data cannot determine held, [`hold`]) and score it;
+/// `first_warning` goes first.
+fn finish(
+    id: &str,
+    data: &Dataset,
+    opts: &FitOptions,
+    found: Searched,
+    first_warning: Option<String>,
+) -> Result<FitResult, FitError> {
+    let info = model_core::registry::find(id).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
+    let Searched { sp, scales, sim, samples, starts, kin, rows, constant_u, mut params, mut evaluations, .. } = found;
+    let (delay, delay_u) = found.delays;
+    let started = Instant::now();
+    let dt = data.dt as f32;
+    let mut warnings: Vec<String> = first_warning.into_iter().collect();
+    warnings.extend(identifiable::constant_command_note(id, data, constant_u));
+    warnings.extend(found.notes);
     let ds = (delay, delay_u);
+    let mut held_params = Vec::new();
+    let mut confidence_warning = None;
+    if matches!(sp.strategy, Strategy::Global | Strategy::Local) {
+        let (y, sc, lm_iter) = (&data.output, scales.y, opts.lm_iterations);
+        let f = hold::Fitted {
+            sim: sim.as_ref(),
+            spec: &sp,
+            kin: &kin,
+            y,
+            rows: &rows,
+            scale: sc,
+            delays: ds,
+            starts: &starts,
+            params: &params,
+        };
+        let r = hold::resolve(&f, lm_iter);
+        (params, held_params, confidence_warning) = (r.params, r.held, r.warning);
+        evaluations += r.evaluations;
+    }
     if sp.structure == Structure::AsymmetricBoucWen {
         warnings.extend(operator::abw_warning(&params, dt, &kin, ds, &starts, &rows));
     }
-    if matches!(sp.strategy, Strategy::Global | Strategy::Local) {
-        warnings.extend(confidence::check(
-            sim.as_ref(),
-            &sp,
-            &kin,
-            &data.output,
-            &rows,
-            scales.y,
-            ds,
-            &starts,
-            &params,
-        ));
-    }
+    warnings.extend(confidence_warning);
+    let fit_seconds = found.seconds + started.elapsed().as_secs_f64();
 
     // Score with the Estimator path, the firmware's code, over the whole recording.
     let p32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
@@ -312,34 +375,16 @@ fn fit_once(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fi
         evaluations,
         replay_ns_per_sample: replay_ns,
         n_params: info.n_params,
-        free_params: sp.free().len() + operator::projected_count(sp.structure),
+        free_params: (sp.free().len() + operator::projected_count(sp.structure)).saturating_sub(held_params.len()),
         state_bytes: info.state_bytes,
         held: rep.held,
         runs,
         warnings,
+        held_params,
         flat: params,
         rate_choice: sp.rate,
         output,
     })
-}
-
-/// The input and the samples as the model saw them: shifted by the fitted delays within each
-/// run (`samples`, as recorded, when there are none).
-fn as_seen(
-    data: &Dataset,
-    samples: Vec<model_core::Sample>,
-    (delay, delay_u): (f64, f64),
-    starts: &[usize],
-) -> (Vec<f64>, Vec<model_core::Sample>) {
-    let shift = |v: &[f64], d: f64| crate::models::alignment::shift_runs(v, d, starts);
-    let input = shift(&data.input, delay);
-    if delay == 0.0 && delay_u == 0.0 {
-        return (input, samples);
-    }
-    let command = data.command.as_deref().map(|u| shift(u, delay_u));
-    let rates = data.rates.as_ref().map(|(dx, ddx)| (shift(dx, delay), shift(ddx, delay)));
-    let samples = crate::models::replay::samples_with_rates(&input, command.as_deref(), rates.as_ref());
-    (input, samples)
 }
 
 /// Whether model `id` has a command-dependent parameter the fit frees (its spec fixes more
@@ -468,6 +513,7 @@ fn identify(
             let window_rows: Vec<usize> = rows.iter().copied().filter(|&i| i < opts.swarm_window).collect();
             let window_rows = if window_rows.len() < 20 { rows.to_vec() } else { window_rows };
             let win = Objective::new(sim, sp, kin, y, &window_rows, y_scale);
+            let polished_start = std::sync::OnceLock::new(); // the papers' start polished: the same every restart
             let mut evals = 0;
             let mut failure = None;
             let best = restarts::until_agree(
@@ -477,12 +523,12 @@ fn identify(
                 notes,
                 |seed| {
                     let swarm = SwarmOptions { seed, ..opts.swarm };
-                    let r = global_search(id, sp, &win, &full, opts, swarm).and_then(|first| match first {
+                    let search = |swarm| global::global_search(id, sp, (&win, &full), opts, swarm, &polished_start);
+                    let r = search(swarm).and_then(|first| match first {
                         (Some(best), e) => Ok((Some(best), e)),
                         // A box where the small swarm found nothing valid (a start that is not a
                         // published set, a narrow valid region) gets a wider search before giving up.
-                        (None, e) => global_search(id, sp, &win, &full, opts, SwarmOptions::wide(seed))
-                            .map(|(b, more)| (b, e + more)),
+                        (None, e) => search(SwarmOptions::wide(seed)).map(|(b, more)| (b, e + more)),
                     });
                     match r {
                         Ok((b, e)) => {
@@ -507,78 +553,6 @@ fn identify(
             valid_or_err(id, sim, r.params, evals)
         }
     }
-}
-
-/// The global phase of [`Strategy::Global`]: swarm on the window, then every candidate and
-/// the papers' start polished there. Returns the candidate with the lowest cost on the whole
-/// training part (`None` when none is valid) and the evaluations spent.
-fn global_search(
-    id: &str,
-    sp: &ModelSpec,
-    win: &Objective<'_>,
-    full: &Objective<'_>,
-    opts: &FitOptions,
-    swarm: SwarmOptions,
-) -> Result<(Option<lm::LocalFit>, usize), FitError> {
-    let mut cands =
-        global::search(win, swarm).map_err(|e| FitError::Swarm { model: id.to_owned(), reason: e.to_string() })?;
-    // The papers' starting values are always polished too: they are often in the
-    // right basin already (Spencer's published set on the Dyke files is), and the
-    // swarm offers the alternatives.
-    let start = sp.start();
-    if !cands.iter().any(|c| c.params == start) {
-        cands.push(global::Candidate { cost: win.cost(&start), params: start });
-    }
-    // Polish every candidate on the window (in parallel), rank them by their cost on
-    // the whole training part (one run each: the window alone does not tell
-    // near-equal basins apart), then finish the best on the whole training part.
-    let polished: Vec<lm::LocalFit> = cands
-        .par_iter()
-        .map(|c| {
-            let r = lm::minimize(win, &c.params, opts.polish_iterations);
-            lm::LocalFit { cost: full.cost(&r.params), evaluations: r.evaluations + 1, ..r }
-        })
-        .collect();
-    let evals =
-        swarm.particles * (swarm.iterations as usize + 1) + polished.iter().map(|r| r.evaluations).sum::<usize>();
-    let best = polished.into_iter().filter(|r| r.cost.is_finite()).min_by(|a, b| a.cost.total_cmp(&b.cost));
-    Ok((best, evals))
-}
-
-/// Fit at every whole-sample delay in ±[`MAX_DELAY_SAMPLES`](crate::models::alignment::MAX_DELAY_SAMPLES)
-/// (`at` fits on the shifted kinematics and returns the fit and its training cost), then
-/// refine the best by a parabola through it and its neighbours. Returns the best fit and
-/// its delay in samples. For the closed-form models, where a fit costs one pass.
-fn scan_delay<T>(
-    kin: &[model_core::Kin],
-    starts: &[usize],
-    at: impl Fn(&[model_core::Kin]) -> Option<(T, f64)> + Sync,
-) -> Option<(T, f64)>
-where
-    T: Send,
-{
-    let m = crate::models::alignment::MAX_DELAY_SAMPLES as i32;
-    let fit_shifted = |d: f64| {
-        let mut shifted = Vec::new();
-        crate::models::alignment::shift_kin_runs(kin, d, 0.0, starts, &mut shifted);
-        at(&shifted).map(|(r, c)| (r, c, d))
-    };
-    let mut grid: Vec<Option<(T, f64, f64)>> = (-m..=m).into_par_iter().map(|d| fit_shifted(f64::from(d))).collect();
-    let cost_at = |i: usize| grid.get(i).and_then(|g| g.as_ref()).map_or(f64::INFINITY, |g| g.1);
-    let best =
-        (0..grid.len()).filter(|&i| cost_at(i).is_finite()).min_by(|&a, &b| cost_at(a).total_cmp(&cost_at(b)))?;
-    let (c_l, c_0, c_r) = (cost_at(best.wrapping_sub(1)), cost_at(best), cost_at(best + 1));
-    let curv = c_l - 2.0 * c_0 + c_r;
-    let refined = (curv.is_finite() && curv > 0.0).then(|| 0.5 * (c_l - c_r) / curv).and_then(|off| {
-        let d = (best as f64 - f64::from(m)) + off.clamp(-0.5, 0.5);
-        fit_shifted(d)
-    });
-    let coarse = grid.get_mut(best)?.take()?;
-    let winner = match refined {
-        Some(r) if r.1 < coarse.1 => r,
-        _ => coarse,
-    };
-    Some((winner.0, winner.2))
 }
 
 fn valid_or_err(
