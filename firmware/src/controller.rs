@@ -20,68 +20,12 @@ use embassy_stm32::adc::InjectedAdc;
 use embassy_stm32::interrupt;
 use embassy_stm32::peripherals::{ADC1, TIM1};
 use embassy_stm32::timer::complementary_pwm::ComplementaryPwm;
-use model_core::control::{
-    ConfigImage, ControlInput, ControlOutput, ControlState, ControlStep, PageError, ValidatedConfig,
-};
-use model_core::models::{algebraic, bouc_wen, lugre, tanh};
-use model_core::Model;
+use model_core::control::{ControlInput, ControlOutput, ValidatedConfig};
 
 use firmware::bridge::{self, Bridge};
+pub use firmware::runner::Loop;
 
 use crate::board;
-
-/// The models this firmware is built with (any page for another model is refused).
-pub enum Loop {
-    Algebraic(ControlStep<algebraic::Algebraic>, ControlState<()>),
-    BoucWen(ControlStep<bouc_wen::BoucWen>, ControlState<bouc_wen::State>),
-    LuGre(ControlStep<lugre::LuGre>, ControlState<lugre::State>),
-    Tanh(ControlStep<tanh::Tanh>, ControlState<()>),
-}
-
-fn make<M: Model>(img: &ConfigImage) -> Result<(ControlStep<M>, ControlState<M::State>), PageError> {
-    let rate = img.rate.build(img.control.get().dt).map_err(PageError::Invalid)?;
-    let step = ControlStep::new(img.model::<M>()?, rate).map_err(PageError::Invalid)?;
-    let state = step.state();
-    Ok((step, state))
-}
-
-impl Loop {
-    /// The controller a page describes, validated (model parameters by `from_params`).
-    pub fn from_image(img: &ConfigImage) -> Result<Self, PageError> {
-        // The ids are the models' own (`Model::ID`, registered in model-core's registry).
-        let id = img.model_id();
-        if id == algebraic::Algebraic::ID {
-            make(img).map(|(s, st)| Self::Algebraic(s, st))
-        } else if id == bouc_wen::BoucWen::ID {
-            make(img).map(|(s, st)| Self::BoucWen(s, st))
-        } else if id == lugre::LuGre::ID {
-            make(img).map(|(s, st)| Self::LuGre(s, st))
-        } else if id == tanh::Tanh::ID {
-            make(img).map(|(s, st)| Self::Tanh(s, st))
-        } else {
-            Err(PageError::WrongModel)
-        }
-    }
-
-    fn slow(&mut self, cfg: &ValidatedConfig, temperature: f32) {
-        match self {
-            Self::Algebraic(s, st) => s.slow(cfg, st, temperature),
-            Self::BoucWen(s, st) => s.slow(cfg, st, temperature),
-            Self::LuGre(s, st) => s.slow(cfg, st, temperature),
-            Self::Tanh(s, st) => s.slow(cfg, st, temperature),
-        }
-    }
-
-    #[inline(always)]
-    fn step(&mut self, cfg: &ValidatedConfig, x: ControlInput) -> ControlOutput {
-        match self {
-            Self::Algebraic(s, st) => s.step(cfg, st, x),
-            Self::BoucWen(s, st) => s.step(cfg, st, x),
-            Self::LuGre(s, st) => s.step(cfg, st, x),
-            Self::Tanh(s, st) => s.step(cfg, st, x),
-        }
-    }
-}
 
 /// The compiled-in configuration ([`firmware::bringup::default_image`]).
 pub use firmware::bringup::default_image;

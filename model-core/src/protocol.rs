@@ -11,6 +11,7 @@
 //! | `0x02` | enable | u8: 1 drive, 0 bridge off | ack |
 //! | `0x03` | reset | – (clears a latched fault, recalibrates) | ack |
 //! | `0x04` | get status | – | status |
+//! | `0x05` | telemetry | u16 decimation (every n-th control sample; 0 stops) | ack; then [`telemetry`] frames |
 //! | `0x10` | config begin | u16 page length (≤ 2048) | ack |
 //! | `0x11` | config data | u16 offset, 1–5 bytes | none (nack on a bad offset) |
 //! | `0x12` | config commit | u32 CRC-32 of the transferred bytes | ack after it is validated, written to flash and swapped in; nack otherwise |
@@ -21,7 +22,16 @@
 //! answers on its reply identifier (see the firmware README); a configuration is only
 //! accepted while the bridge is off.
 
+//!
+//! On a byte stream (the UART link, TCP for the virtual board) every frame is framed by
+//! [`frame`] (COBS, CRC-32); [`device`] is the board's command handling, [`telemetry`] the
+//! signal stream (UART/TCP only: its frames are longer than a CAN frame).
+
 use crate::control::page::{ConfigImage, PageError, PAGE_BYTES};
+
+pub mod device;
+pub mod frame;
+pub mod telemetry;
 
 /// Largest frame.
 pub const FRAME: usize = 8;
@@ -35,6 +45,7 @@ pub enum Command {
     Enable(bool),
     Reset,
     GetStatus,
+    Telemetry { decimation: u16 },
     ConfigBegin { len: u16 },
     ConfigData { offset: u16, len: u8, data: [u8; CHUNK] },
     ConfigCommit { crc: u32 },
@@ -89,6 +100,7 @@ impl Command {
             Self::Enable(_) => 0x02,
             Self::Reset => 0x03,
             Self::GetStatus => 0x04,
+            Self::Telemetry { .. } => 0x05,
             Self::ConfigBegin { .. } => 0x10,
             Self::ConfigData { .. } => 0x11,
             Self::ConfigCommit { .. } => 0x12,
@@ -109,6 +121,7 @@ impl Command {
             (0x02, [e]) if *e <= 1 => Self::Enable(*e == 1),
             (0x03, []) => Self::Reset,
             (0x04, []) => Self::GetStatus,
+            (0x05, [a, b]) => Self::Telemetry { decimation: u16::from_le_bytes([*a, *b]) },
             (0x10, [a, b]) => Self::ConfigBegin { len: u16::from_le_bytes([*a, *b]) },
             (0x11, [a, b, data @ ..]) if !data.is_empty() && data.len() <= CHUNK => {
                 let mut d = [0u8; CHUNK];
@@ -118,7 +131,7 @@ impl Command {
                 Self::ConfigData { offset: u16::from_le_bytes([*a, *b]), len: data.len() as u8, data: d }
             }
             (0x12, r) => Self::ConfigCommit { crc: u32::from_le_bytes(le4(r).ok_or(Nack::Malformed)?) },
-            (0x01..=0x04 | 0x10..=0x12, _) => return Err(Nack::Malformed),
+            (0x01..=0x05 | 0x10..=0x12, _) => return Err(Nack::Malformed),
             _ => return Err(Nack::Unknown),
         })
     }
@@ -131,6 +144,7 @@ impl Command {
             Self::SetTorque(v) => w.put(&v.to_le_bytes()),
             Self::Enable(e) => w.put(&[u8::from(e)]),
             Self::Reset | Self::GetStatus => {}
+            Self::Telemetry { decimation } => w.put(&decimation.to_le_bytes()),
             Self::ConfigBegin { len } => w.put(&len.to_le_bytes()),
             Self::ConfigData { offset, len, data } => {
                 w.put(&offset.to_le_bytes());

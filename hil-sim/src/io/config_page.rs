@@ -28,21 +28,16 @@ pub enum PageBuildError {
     Page { path: PathBuf, source: PageError },
     #[error("default control settings at {control_hz} Hz: {source}")]
     Control { control_hz: f32, source: ParamError },
-    #[error("{}: model `{model}`: the firmware runs only {} (it refuses any other page)", path.display(), FIRMWARE_MODELS.join(", "))]
+    #[error("{}: model `{model}`: the firmware runs only the models that map the field to torque ({}); this one is a damper model (force from displacement and command), which the board cannot run", path.display(), FIRMWARE_MODELS.join(", "))]
     NotInFirmware { path: PathBuf, model: String },
     #[error("{}: {model} parameters give a torque of {value:.3e} on a representative flux sweep (±{TRIAL_B} T); \
              the firmware's f32 control step cannot use them", path.display())]
     Absurd { path: PathBuf, model: String, value: f32 },
 }
 
-/// The models the firmware is built with (`firmware/src/controller.rs`, `Loop`): a page
-/// for any other model is refused there (`PageError::WrongModel`), so it is refused here.
-pub const FIRMWARE_MODELS: [&str; 4] = [
-    model_core::models::algebraic::Algebraic::ID,
-    model_core::models::bouc_wen::BoucWen::ID,
-    model_core::models::lugre::LuGre::ID,
-    model_core::models::tanh::Tanh::ID,
-];
+/// The models the firmware is built with (`firmware::runner::Loop`): a page for any other
+/// model is refused there (`PageError::WrongModel`), so it is refused here.
+pub const FIRMWARE_MODELS: [&str; firmware::runner::MODELS.len()] = firmware::runner::MODELS;
 
 /// Peak flux density of the trial sweep, T.
 const TRIAL_B: f32 = 1.5;
