@@ -34,7 +34,8 @@ use firmware::bringup::{self, BoardMismatch};
 use firmware::link::{LinkAction, LinkWatch};
 use firmware::slots::{self, Boot, Slot, SlotState};
 use model_core::control::{ConfigImage, PageError, ValidatedConfig};
-use model_core::protocol::{mode_code, Command, Nack, PageAssembler, Response, FRAME};
+use model_core::protocol::device::{Action as Do, Device, StatusFigures};
+use model_core::protocol::{mode_code, Command, Nack, Response, FRAME};
 
 use crate::board::{self, flash, Board};
 use crate::controller::{self, Control, Loop, Snapshot};
@@ -399,7 +400,7 @@ fn reply(r: Response) -> Option<embassy_stm32::can::Frame> {
 /// is released (`firmware::link`).
 #[embassy_executor::task]
 async fn commands(mut can: embassy_stm32::can::Can<'static>, mut running: Option<(Slot, u32)>) {
-    let mut page = PageAssembler::default();
+    let mut device = Device::default();
     let now_ms = || Instant::now().as_millis();
     let mut link = LinkWatch::new(board::COMMAND_TIMEOUT_MS, now_ms());
     loop {
@@ -427,50 +428,43 @@ async fn commands(mut can: embassy_stm32::can::Can<'static>, mut running: Option
             continue;
         }
         let data = env.frame.data();
-        let code = data.first().copied().unwrap_or(0);
-        let decoded = Command::decode(data);
-        if decoded.is_ok() {
+        if Command::decode(data).is_ok() {
             link.heard(now_ms());
         }
-        let answer = match decoded {
-            Err(why) => Some(Response::Nack(code, why)),
-            Ok(Command::SetTorque(t)) => {
+        let answer = match device.handle(data) {
+            (Do::None, r) => r,
+            (Do::Reference(t), r) => {
                 controller::REFERENCE.store(t.to_bits(), Ordering::Relaxed);
-                None
+                r
             }
-            Ok(Command::Enable(e)) => {
+            (Do::Enable(e), r) => {
                 controller::ENABLE.store(e, Ordering::Relaxed);
-                Some(Response::Ack(code))
+                r
             }
-            Ok(Command::Reset) => {
+            (Do::Reset, r) => {
                 controller::RESET.store(true, Ordering::Relaxed);
-                Some(Response::Ack(code))
+                r
             }
-            Ok(Command::GetStatus) => {
+            (Do::Status, _) => {
                 let s = critical_section::with(|cs| controller::TELEMETRY.borrow(cs).get());
-                let ovr = controller::OVERRUNS.load(Ordering::Relaxed).min(255) as u8;
-                Some(Response::Status {
+                Some(device.status(StatusFigures {
                     mode: mode_code(s.out.mode),
                     fault: s.out.fault.code(),
-                    overruns: ovr,
+                    overruns: controller::OVERRUNS.load(Ordering::Relaxed),
                     torque_est: s.out.torque_est,
-                })
+                }))
             }
-            Ok(Command::ConfigBegin { len }) => Some(match page.begin(len) {
-                Ok(()) => Response::Ack(code),
-                Err(why) => Response::Nack(code, why),
-            }),
-            Ok(Command::ConfigData { offset, len, data }) => page
-                .data(offset, data.get(..usize::from(len)).unwrap_or(&[]))
-                .err()
-                .map(|why| Response::Nack(code, why)),
-            Ok(Command::ConfigCommit { crc }) => Some(match commit(&mut page, crc, running).await {
-                Ok(now) => {
+            (Do::Commit, _) => {
+                let result = match device.take_page() {
+                    Some((bytes, img)) => commit(&bytes, &img, running).await.map(|now| (now, img.crc())),
+                    None => Err(Nack::Sequence),
+                };
+                if let Ok((now, crc)) = result {
                     running = Some(now);
-                    Response::Ack(code)
+                    device.set_active_crc(crc);
                 }
-                Err(why) => Response::Nack(code, why),
-            }),
+                Some(device.committed(result.map(|_| ())))
+            }
         };
         if let Some(frame) = answer.and_then(reply) {
             can.write(&frame).await;
@@ -481,12 +475,15 @@ async fn commands(mut can: embassy_stm32::can::Can<'static>, mut running: Option
 /// Validate the received page, write it to the slot not running (erase, image, commit
 /// record last; the waits yield, so the control interrupt and the watchdog task keep
 /// running), read it back, hand it to the control interrupt.
-async fn commit(page: &mut PageAssembler, crc: u32, running: Option<(Slot, u32)>) -> Result<(Slot, u32), Nack> {
+async fn commit(
+    bytes: &[u8; model_core::control::page::PAGE_BYTES],
+    img: &ConfigImage,
+    running: Option<(Slot, u32)>,
+) -> Result<(Slot, u32), Nack> {
     if controller::ENABLE.load(Ordering::Relaxed) {
         return Err(Nack::Busy);
     }
-    let (bytes, img) = page.commit(crc)?;
-    let (lp, cfg) = runnable(&img).map_err(|_| Nack::InvalidPage)?;
+    let (lp, cfg) = runnable(img).map_err(|_| Nack::InvalidPage)?;
     let (slot, seq) = slots::commit_target(running);
     let image = slots::slot_image(bytes, seq).ok_or(Nack::InvalidPage)?;
     flash::program_slot(slot, &image).await.map_err(|e| {

@@ -248,7 +248,8 @@ mod bench {
     }
 
     /// The control step of model `M` (as `firmware::runner::Loop` runs it) over the same
-    /// sequence as [`control_step`], reported as `control_step_<id>`.
+    /// sequence as [`control_step`], reported as `control_step_<id>` (and its slow pass as
+    /// `supervisor_slow_<id>`: it steps the model too, for the feed-forward's linearisation).
     fn control_of<M: Model>(flat: &[f32]) {
         let Ok(model) = M::from_params(flat, DT) else { fail(M::ID) };
         let Ok(rate) = RateParams::filtered(DT, 150.0) else { fail("rate") };
@@ -258,6 +259,7 @@ mod bench {
         let slow: fn(&ControlStep<M>, &ValidatedConfig, &mut ControlState<M::State>, f32) =
             black_box(ControlStep::<M>::slow);
         hprintln!("step control_step_{} {:#x} {}", M::ID, f as usize, N);
+        hprintln!("step supervisor_slow_{} {:#x} {}", M::ID, slow as usize, N.div_ceil(SLOW));
         let cfg = control_config();
         let mut s = step.state();
         drive_sequence(|k, input| {

@@ -43,6 +43,8 @@ pub struct Device {
     decimation: u16,
     count: u16,
     seq: u16,
+    /// CRC-32 of the running page (0: compiled-in defaults).
+    active_crc: u32,
 }
 
 impl Device {
@@ -63,6 +65,7 @@ impl Device {
             }
             Command::Reset => (Action::Reset, ack),
             Command::GetStatus => (Action::Status, None),
+            Command::ConfigQuery => (Action::None, Some(Response::PageCrc(self.active_crc))),
             Command::Telemetry { decimation } => {
                 self.decimation = decimation;
                 self.count = 0;
@@ -91,6 +94,11 @@ impl Device {
     /// The page of the last [`Action::Commit`] (its bytes and image), until taken.
     pub fn take_page(&mut self) -> Option<([u8; PAGE_BYTES], ConfigImage)> {
         self.pending.take()
+    }
+
+    /// Record the running page's CRC-32 (at start-up, and after a commit was stored).
+    pub fn set_active_crc(&mut self, crc: u32) {
+        self.active_crc = crc;
     }
 
     /// The reply to a commit once the caller stored (or failed to store) the page.
