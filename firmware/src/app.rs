@@ -409,6 +409,7 @@ async fn commands(mut can: embassy_stm32::can::Can<'static>, mut running: Option
         if link.poll(now_ms(), controller::ENABLE.load(Ordering::Relaxed)) == LinkAction::Release {
             controller::ENABLE.store(false, Ordering::Relaxed);
             controller::REFERENCE.store(0, Ordering::Relaxed);
+            device.released();
             warn!("no command for {} ms: drive released", board::COMMAND_TIMEOUT_MS);
         }
         let env = match got {

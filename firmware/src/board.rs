@@ -26,8 +26,7 @@ pub const HSE_HZ: u32 = 24_000_000;
 pub const CAN_BITRATE: u32 = 1_000_000;
 pub const CAN_ID_CMD: u16 = 0x120;
 pub const CAN_ID_REPLY: u16 = 0x121;
-/// The host must be heard this often while the drive is enabled (`firmware::link`), ms.
-pub const COMMAND_TIMEOUT_MS: u64 = 100;
+pub use firmware::link::COMMAND_TIMEOUT_MS;
 /// Independent watchdog timeout, µs.
 pub const WATCHDOG_US: u32 = 50_000;
 

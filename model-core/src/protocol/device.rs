@@ -96,6 +96,11 @@ impl Device {
         self.pending.take()
     }
 
+    /// The drive was released (the host fell silent): a commit is allowed again.
+    pub fn released(&mut self) {
+        self.enabled = false;
+    }
+
     /// Record the running page's CRC-32 (at start-up, and after a commit was stored).
     pub fn set_active_crc(&mut self, crc: u32) {
         self.active_crc = crc;
