@@ -28,6 +28,8 @@ pub struct Recorded {
 const SILENT: Duration = Duration::from_millis(1000);
 /// The profile's reference is sent at most this often (board time), s.
 const PROFILE_PERIOD: f64 = 1e-3;
+/// Without a profile, a command at least this often (board time), s.
+const KEEPALIVE_PERIOD: f64 = 20e-3;
 
 /// A reference profile: rows `t,reference` (header optional), times increasing.
 pub fn read_profile(path: &Path) -> Result<Vec<(f64, f64)>, LinkError> {
@@ -99,10 +101,15 @@ pub fn record(
             let ms = ((t - start) * 1e3) as u64;
             progress.advance(ms.saturating_sub(done_ms));
             done_ms = done_ms.max(ms);
-            if let Some(p) = profile {
-                if t - start >= next_send {
+            if t - start >= next_send {
+                // The profile's reference, or a status request that only keeps the link
+                // alive (the board releases the drive after 100 ms without a command).
+                if let Some(p) = profile {
                     next_send = t - start + PROFILE_PERIOD;
                     link.send(Command::SetTorque(profile_at(p, t - start) as f32))?;
+                } else {
+                    next_send = t - start + KEEPALIVE_PERIOD;
+                    link.send(Command::GetStatus)?;
                 }
             }
         }
