@@ -94,7 +94,8 @@ pub fn record(
             last_us = s.t_us;
             let t = (wraps as f64 * 4_294_967_296.0 + f64::from(s.t_us)) * 1e-6;
             let start = *t0.get_or_insert(t);
-            if t - start >= seconds {
+            // Half a microsecond of slack: board times are whole microseconds.
+            if t - start >= seconds - 0.5e-6 {
                 break 'outer;
             }
             rows.push((t, s));
