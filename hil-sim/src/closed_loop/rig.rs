@@ -111,7 +111,7 @@ impl Rig {
         }
         let overrun = active == Some(Injection::Overrun);
         let m = self.plant.measure();
-        if self.k % self.slow_every == 0 {
+        if self.k.is_multiple_of(self.slow_every) {
             ctrl.slow(cfg, if self.use_temp { m.temperature as f32 } else { f32::NAN });
         }
         let input = ControlInput {
