@@ -1,13 +1,17 @@
 //! The controller a configuration page describes, for every model that maps the field to
 //! torque: one variant per model, built once from a validated page (`from_image`), then
 //! stepped by the control interrupt (and by `hil-sim virtual-board` on the host) without
-//! a failure path. The damper models (command-dependent force laws in x) are not built in.
+//! a failure path. The damper models (command-dependent force laws in x) are not built in,
+//! and neither is `preisach`: its 50 × 50 weight table (10 KB) is built by value through
+//! `from_params` → `ControlStep::new` → the enum, several copies deep on the stack, which
+//! the commit and boot paths cannot afford next to 55 KB of static RAM (it needs an in-place
+//! constructor in model-core first).
 
 use model_core::control::ValidatedConfig;
 use model_core::control::{ConfigImage, ControlInput, ControlOutput, ControlState, ControlStep, PageError};
 use model_core::models::{
     algebraic, bouc_wen, bouc_wen_asym, dahl, gpi, hammerstein_wiener, lugre, maxwell_slip, narx, prandtl_ishlinskii,
-    preisach, tanh,
+    tanh,
 };
 use model_core::Model;
 
@@ -22,7 +26,6 @@ macro_rules! clutch_models {
             Dahl => dahl::Registered,
             HammersteinWiener => hammerstein_wiener::Registered,
             Narx => narx::Registered,
-            Preisach => preisach::Registered,
             PrandtlIshlinskii => prandtl_ishlinskii::Registered,
             Gpi => gpi::Registered,
             MaxwellSlip => maxwell_slip::Registered,
@@ -98,5 +101,11 @@ mod tests {
         let img = crate::bringup::default_image().expect("image");
         let lp = Loop::from_image(&img).expect("loop");
         assert_eq!(lp.model_id(), img.model_id());
+        println!(
+            "Loop {} B, ConfigImage {} B, Device {} B",
+            core::mem::size_of::<Loop>(),
+            core::mem::size_of::<ConfigImage>(),
+            core::mem::size_of::<model_core::protocol::device::Device>()
+        );
     }
 }

@@ -275,6 +275,11 @@ impl PageAssembler {
         }
     }
 
+    /// The page bytes received (0xFF beyond what was sent).
+    pub fn bytes(&self) -> &[u8; PAGE_BYTES] {
+        &self.buf
+    }
+
     /// End the transfer: the bytes must match `crc` (CRC-32 of the `len` bytes sent), then
     /// the page must decode and validate. Returns the page bytes and the image.
     pub fn commit(&mut self, crc: u32) -> Result<(&[u8; PAGE_BYTES], ConfigImage), Nack> {

@@ -119,7 +119,10 @@ impl VirtualBoard {
             (Action::Status, _) => Some(self.status()),
             (Action::Commit, _) => {
                 let result = match self.device.take_page() {
-                    Some((bytes, img)) => self.commit(&bytes, &img),
+                    Some(img) => {
+                        let bytes = *self.device.page_bytes();
+                        self.commit(&bytes, &img)
+                    }
                     None => Err(Nack::Sequence),
                 };
                 Some(self.device.committed(result))

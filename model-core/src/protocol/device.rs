@@ -38,7 +38,7 @@ pub struct StatusFigures {
 pub struct Device {
     page: PageAssembler,
     enabled: bool,
-    pending: Option<([u8; PAGE_BYTES], ConfigImage)>,
+    pending: Option<ConfigImage>,
     /// Every `decimation`-th sample is streamed (0: off).
     decimation: u16,
     count: u16,
@@ -81,8 +81,8 @@ impl Device {
                     return (Action::None, Some(Response::Nack(code, Nack::Busy)));
                 }
                 match self.page.commit(crc) {
-                    Ok((bytes, img)) => {
-                        self.pending = Some((*bytes, img));
+                    Ok((_, img)) => {
+                        self.pending = Some(img);
                         (Action::Commit, None)
                     }
                     Err(why) => (Action::None, Some(Response::Nack(code, why))),
@@ -91,9 +91,14 @@ impl Device {
         }
     }
 
-    /// The page of the last [`Action::Commit`] (its bytes and image), until taken.
-    pub fn take_page(&mut self) -> Option<([u8; PAGE_BYTES], ConfigImage)> {
+    /// The decoded page of the last [`Action::Commit`], until taken.
+    pub fn take_page(&mut self) -> Option<ConfigImage> {
         self.pending.take()
+    }
+
+    /// The bytes of the page last transferred (what a commit writes to flash).
+    pub fn page_bytes(&self) -> &[u8; PAGE_BYTES] {
+        self.page.bytes()
     }
 
     /// The drive was released (the host fell silent): a commit is allowed again.
@@ -119,6 +124,11 @@ impl Device {
             overruns: u8::try_from(s.overruns).unwrap_or(u8::MAX),
             torque_est: s.torque_est,
         }
+    }
+
+    /// Every how many control samples telemetry is streamed (0: off).
+    pub fn decimation(&self) -> u16 {
+        self.decimation
     }
 
     /// Called once per control sample: true when this sample is to be streamed.
