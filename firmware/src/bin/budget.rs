@@ -247,6 +247,10 @@ mod bench {
         );
     }
 
+    type StepOf<M> =
+        fn(&ControlStep<M>, &ValidatedConfig, &mut ControlState<<M as Model>::State>, ControlInput) -> ControlOutput;
+    type SlowOf<M> = fn(&ControlStep<M>, &ValidatedConfig, &mut ControlState<<M as Model>::State>, f32);
+
     /// The control step of model `M` (as `firmware::runner::Loop` runs it) over the same
     /// sequence as [`control_step`], reported as `control_step_<id>` (and its slow pass as
     /// `supervisor_slow_<id>`: it steps the model too, for the feed-forward's linearisation).
@@ -254,10 +258,8 @@ mod bench {
         let Ok(model) = M::from_params(flat, DT) else { fail(M::ID) };
         let Ok(rate) = RateParams::filtered(DT, 150.0) else { fail("rate") };
         let Ok(step) = ControlStep::new(model, rate) else { fail("control step") };
-        let f: fn(&ControlStep<M>, &ValidatedConfig, &mut ControlState<M::State>, ControlInput) -> ControlOutput =
-            black_box(ControlStep::<M>::step);
-        let slow: fn(&ControlStep<M>, &ValidatedConfig, &mut ControlState<M::State>, f32) =
-            black_box(ControlStep::<M>::slow);
+        let f: StepOf<M> = black_box(ControlStep::<M>::step);
+        let slow: SlowOf<M> = black_box(ControlStep::<M>::slow);
         hprintln!("step control_step_{} {:#x} {}", M::ID, f as usize, N);
         hprintln!("step supervisor_slow_{} {:#x} {}", M::ID, slow as usize, N.div_ceil(SLOW));
         let cfg = control_config();
