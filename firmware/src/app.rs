@@ -560,10 +560,7 @@ async fn serial(uart: BufferedUart<'static>) {
         };
         for &byte in buf.get(..n).unwrap_or(&[]) {
             let Some(Ok(payload)) = deframer.push(byte) else { continue };
-            let mut frame = [0u8; FRAME];
-            let len = payload.len().min(FRAME);
-            frame[..len].copy_from_slice(payload.get(..len).unwrap_or(&[]));
-            if let Some(r) = serve(&mut device, frame.get(..len).unwrap_or(&[])).await {
+            if let Some(r) = serve(&mut device, payload).await {
                 let mut f = [0u8; FRAME];
                 let m = r.encode(&mut f);
                 let mut out = [0u8; MAX_ENCODED];
