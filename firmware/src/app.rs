@@ -23,10 +23,12 @@ use embassy_stm32::can::filter::{Action, FilterType, StandardFilter, StandardFil
 use embassy_stm32::can::{self, CanConfigurator};
 use embassy_stm32::interrupt::{InterruptExt, Priority};
 use embassy_stm32::peripherals::FDCAN1;
+use embassy_stm32::peripherals::LPUART1;
 use embassy_stm32::time::Hertz;
 use embassy_stm32::timer::complementary_pwm::{ComplementaryPwm, Mms2, Ossi, Ossr};
 use embassy_stm32::timer::low_level::CountingMode;
 use embassy_stm32::timer::Channel;
+use embassy_stm32::usart::{BufferedInterruptHandler, BufferedUart};
 use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::{bind_interrupts, interrupt, Config};
 use embassy_time::{Duration, Instant, Ticker, Timer};
@@ -34,7 +36,10 @@ use firmware::bringup::{self, BoardMismatch};
 use firmware::link::{LinkAction, LinkWatch};
 use firmware::slots::{self, Boot, Slot, SlotState};
 use model_core::control::{ConfigImage, PageError, ValidatedConfig};
-use model_core::protocol::{mode_code, Command, Nack, PageAssembler, Response, FRAME};
+use model_core::protocol::device::{Action as Do, Device, StatusFigures};
+use model_core::protocol::frame::{encode, Deframer, MAX_ENCODED};
+use model_core::protocol::telemetry::Telemetry;
+use model_core::protocol::{mode_code, Command, Nack, Response, FRAME};
 
 use crate::board::{self, flash, Board};
 use crate::controller::{self, Control, Loop, Snapshot};
@@ -43,6 +48,7 @@ use crate::safety::fatal;
 bind_interrupts!(struct Irqs {
     FDCAN1_IT0 => can::IT0InterruptHandler<FDCAN1>;
     FDCAN1_IT1 => can::IT1InterruptHandler<FDCAN1>;
+    LPUART1 => BufferedInterruptHandler<LPUART1>;
 });
 
 /// Clock tree: the Nucleo's 24 MHz crystal / 6 × 85 = 340 MHz VCO; / 2 on PLL R = 170 MHz
@@ -274,18 +280,40 @@ async fn main(spawner: Spawner) {
     }
 
     let can = start_can(b.can, b.can_rx, b.can_tx);
+    critical_section::with(|cs| RUNNING_CONFIG.borrow(cs).set(loaded.running));
+    let uart = start_uart(b.uart, b.uart_rx, b.uart_tx);
 
     let iwdg = IndependentWatchdog::new(b.iwdg, board::WATCHDOG_US);
-    match (telemetry(), commands(can, loaded.running), supervisor()) {
-        (Ok(t), Ok(c), Ok(s)) => {
+    match (telemetry(), commands(can), serial(uart), supervisor()) {
+        (Ok(t), Ok(c), Ok(u), Ok(s)) => {
             spawner.spawn(t);
             spawner.spawn(c);
+            spawner.spawn(u);
             spawner.spawn(s);
         }
         _ => fatal("spawning tasks"),
     }
     info!("running");
     watchdog(iwdg).await;
+}
+
+/// LPUART1 at [`board::UART_BAUD`], 8N1, interrupt-driven with its buffers.
+fn start_uart(
+    uart: embassy_stm32::Peri<'static, LPUART1>,
+    rx: embassy_stm32::Peri<'static, embassy_stm32::peripherals::PA3>,
+    tx: embassy_stm32::Peri<'static, embassy_stm32::peripherals::PA2>,
+) -> BufferedUart<'static> {
+    let (Some(tx_buf), Some(rx_buf)) =
+        (cortex_m::singleton!(: [u8; 512] = [0; 512]), cortex_m::singleton!(: [u8; 256] = [0; 256]))
+    else {
+        fatal("UART buffers")
+    };
+    let mut config = embassy_stm32::usart::Config::default();
+    config.baudrate = board::UART_BAUD;
+    match BufferedUart::new(uart, rx, tx, tx_buf, rx_buf, Irqs, config) {
+        Ok(u) => u,
+        Err(_) => fatal("LPUART1 configuration"),
+    }
 }
 
 /// FDCAN1 in normal mode: bit timing from the crystal (`firmware::can_timing`), one
@@ -394,22 +422,101 @@ fn reply(r: Response) -> Option<embassy_stm32::can::Frame> {
     embassy_stm32::can::Frame::new_standard(board::CAN_ID_REPLY, buf.get(..n)?).ok()
 }
 
+/// The configuration running (slot, commit sequence), shared by the link tasks.
+static RUNNING_CONFIG: critical_section::Mutex<core::cell::Cell<Option<(Slot, u32)>>> =
+    critical_section::Mutex::new(core::cell::Cell::new(None));
+/// A commit is being written (the other link's commit is refused meanwhile).
+static COMMITTING: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
+/// The command timeout of both links together (`firmware::link`).
+static LINK: critical_section::Mutex<core::cell::Cell<LinkWatch>> =
+    critical_section::Mutex::new(core::cell::Cell::new(LinkWatch::new(board::COMMAND_TIMEOUT_MS, 0)));
+
+fn now_ms() -> u64 {
+    Instant::now().as_millis()
+}
+
+/// Release the drive when no link has been heard for `COMMAND_TIMEOUT_MS`.
+fn watch_link(device: &mut Device) {
+    let enabled = controller::ENABLE.load(Ordering::Relaxed);
+    let action = critical_section::with(|cs| {
+        let mut l = LINK.borrow(cs).get();
+        let a = l.poll(now_ms(), enabled);
+        LINK.borrow(cs).set(l);
+        a
+    });
+    if action == LinkAction::Release {
+        controller::ENABLE.store(false, Ordering::Relaxed);
+        controller::REFERENCE.store(0, Ordering::Relaxed);
+        warn!("no command for {} ms: drive released", board::COMMAND_TIMEOUT_MS);
+    }
+    if !controller::ENABLE.load(Ordering::Relaxed) {
+        device.released();
+    }
+}
+
+/// One frame from a link through the shared command handler
+/// (`model_core::protocol::device`): its action done, its reply returned.
+async fn serve(device: &mut Device, data: &[u8]) -> Option<Response> {
+    if Command::decode(data).is_ok() {
+        critical_section::with(|cs| {
+            let mut l = LINK.borrow(cs).get();
+            l.heard(now_ms());
+            LINK.borrow(cs).set(l);
+        });
+    }
+    match device.handle(data) {
+        (Do::None, r) => r,
+        (Do::Reference(t), r) => {
+            controller::REFERENCE.store(t.to_bits(), Ordering::Relaxed);
+            r
+        }
+        (Do::Enable(e), r) => {
+            controller::ENABLE.store(e, Ordering::Relaxed);
+            r
+        }
+        (Do::Reset, r) => {
+            controller::RESET.store(true, Ordering::Relaxed);
+            r
+        }
+        (Do::Status, _) => {
+            let s = critical_section::with(|cs| controller::TELEMETRY.borrow(cs).get());
+            Some(device.status(StatusFigures {
+                mode: mode_code(s.out.mode),
+                fault: s.out.fault.code(),
+                overruns: controller::OVERRUNS.load(Ordering::Relaxed),
+                torque_est: s.out.torque_est,
+            }))
+        }
+        (Do::Commit, _) => {
+            let result = match (device.take_page(), COMMITTING.swap(true, Ordering::Acquire)) {
+                (_, true) => Err(Nack::Busy),
+                (None, false) => Err(Nack::Sequence),
+                (Some(img), false) => {
+                    let running = critical_section::with(|cs| RUNNING_CONFIG.borrow(cs).get());
+                    let r = commit(device.page_bytes(), &img, running).await.map(|now| (now, img.crc()));
+                    COMMITTING.store(false, Ordering::Release);
+                    r
+                }
+            };
+            if let Ok((now, crc)) = result {
+                critical_section::with(|cs| RUNNING_CONFIG.borrow(cs).set(Some(now)));
+                device.set_active_crc(crc);
+            }
+            Some(device.committed(result.map(|_| ())))
+        }
+    }
+}
+
 /// CAN commands (protocol in `model_core::protocol`). The acceptance filter lets only
-/// `CAN_ID_CMD` into the FIFO. A drive enabled with no command for `COMMAND_TIMEOUT_MS`
-/// is released (`firmware::link`).
+/// `CAN_ID_CMD` into the FIFO. A drive enabled with no command on either link for
+/// `COMMAND_TIMEOUT_MS` is released (`firmware::link`).
 #[embassy_executor::task]
-async fn commands(mut can: embassy_stm32::can::Can<'static>, mut running: Option<(Slot, u32)>) {
-    let mut page = PageAssembler::default();
-    let now_ms = || Instant::now().as_millis();
-    let mut link = LinkWatch::new(board::COMMAND_TIMEOUT_MS, now_ms());
+async fn commands(mut can: embassy_stm32::can::Can<'static>) {
+    let mut device = Device::default();
     loop {
         let wait = Duration::from_millis(board::COMMAND_TIMEOUT_MS / 4);
         let got = embassy_time::with_timeout(wait, can.read()).await;
-        if link.poll(now_ms(), controller::ENABLE.load(Ordering::Relaxed)) == LinkAction::Release {
-            controller::ENABLE.store(false, Ordering::Relaxed);
-            controller::REFERENCE.store(0, Ordering::Relaxed);
-            warn!("no command for {} ms: drive released", board::COMMAND_TIMEOUT_MS);
-        }
+        watch_link(&mut device);
         let env = match got {
             Err(_timeout) => continue,
             Ok(Ok(env)) => env,
@@ -426,54 +533,59 @@ async fn commands(mut can: embassy_stm32::can::Can<'static>, mut running: Option
         if id != board::CAN_ID_CMD {
             continue;
         }
-        let data = env.frame.data();
-        let code = data.first().copied().unwrap_or(0);
-        let decoded = Command::decode(data);
-        if decoded.is_ok() {
-            link.heard(now_ms());
-        }
-        let answer = match decoded {
-            Err(why) => Some(Response::Nack(code, why)),
-            Ok(Command::SetTorque(t)) => {
-                controller::REFERENCE.store(t.to_bits(), Ordering::Relaxed);
-                None
-            }
-            Ok(Command::Enable(e)) => {
-                controller::ENABLE.store(e, Ordering::Relaxed);
-                Some(Response::Ack(code))
-            }
-            Ok(Command::Reset) => {
-                controller::RESET.store(true, Ordering::Relaxed);
-                Some(Response::Ack(code))
-            }
-            Ok(Command::GetStatus) => {
-                let s = critical_section::with(|cs| controller::TELEMETRY.borrow(cs).get());
-                let ovr = controller::OVERRUNS.load(Ordering::Relaxed).min(255) as u8;
-                Some(Response::Status {
-                    mode: mode_code(s.out.mode),
-                    fault: s.out.fault.code(),
-                    overruns: ovr,
-                    torque_est: s.out.torque_est,
-                })
-            }
-            Ok(Command::ConfigBegin { len }) => Some(match page.begin(len) {
-                Ok(()) => Response::Ack(code),
-                Err(why) => Response::Nack(code, why),
-            }),
-            Ok(Command::ConfigData { offset, len, data }) => page
-                .data(offset, data.get(..usize::from(len)).unwrap_or(&[]))
-                .err()
-                .map(|why| Response::Nack(code, why)),
-            Ok(Command::ConfigCommit { crc }) => Some(match commit(&mut page, crc, running).await {
-                Ok(now) => {
-                    running = Some(now);
-                    Response::Ack(code)
-                }
-                Err(why) => Response::Nack(code, why),
-            }),
-        };
+        let answer = serve(&mut device, env.frame.data()).await;
         if let Some(frame) = answer.and_then(reply) {
             can.write(&frame).await;
+        }
+    }
+}
+
+/// The serial link on LPUART1 (the ST-LINK virtual COM port): the same commands, each
+/// frame COBS-encoded with a CRC-32 (`model_core::protocol::frame`), and the telemetry
+/// stream: the control interrupt's samples at the decimation the host asked for, numbered
+/// by sample index (a gap is a lost frame), in SI units.
+#[embassy_executor::task]
+async fn serial(uart: BufferedUart<'static>) {
+    use embedded_io_async::{Read, Write};
+    let (mut tx, mut rx) = uart.split();
+    let mut device = Device::default();
+    let mut deframer = Deframer::default();
+    let mut buf = [0u8; 64];
+    loop {
+        let got = embassy_time::with_timeout(Duration::from_micros(500), rx.read(&mut buf)).await;
+        watch_link(&mut device);
+        let n = match got {
+            Ok(Ok(n)) => n,
+            Ok(Err(_)) | Err(_) => 0,
+        };
+        for &byte in buf.get(..n).unwrap_or(&[]) {
+            let Some(Ok(payload)) = deframer.push(byte) else { continue };
+            if let Some(r) = serve(&mut device, payload).await {
+                let mut f = [0u8; FRAME];
+                let m = r.encode(&mut f);
+                let mut out = [0u8; MAX_ENCODED];
+                let k = encode(f.get(..m).unwrap_or(&[]), &mut out);
+                let _ = tx.write_all(out.get(..k).unwrap_or(&[])).await;
+            }
+        }
+        let d = u32::from(device.decimation());
+        controller::STREAM_DECIMATION.store(d, Ordering::Relaxed);
+        while let Some(s) = critical_section::with(|cs| controller::STREAM.borrow_ref_mut(cs).pop()) {
+            let t = Telemetry {
+                t_us: s.n.wrapping_mul(1_000_000 / board::CONTROL_HZ),
+                b: s.out.b,
+                current: s.out.current,
+                torque_est: s.out.torque_est,
+                reference: s.reference,
+                duty: s.out.duty,
+                mode: mode_code(s.out.mode),
+                fault: s.out.fault.code(),
+                torque_true: f32::NAN,
+            };
+            let seq = (s.n / d.max(1)) as u16;
+            let mut out = [0u8; MAX_ENCODED];
+            let k = encode(&t.encode(seq), &mut out);
+            let _ = tx.write_all(out.get(..k).unwrap_or(&[])).await;
         }
     }
 }
@@ -481,12 +593,17 @@ async fn commands(mut can: embassy_stm32::can::Can<'static>, mut running: Option
 /// Validate the received page, write it to the slot not running (erase, image, commit
 /// record last; the waits yield, so the control interrupt and the watchdog task keep
 /// running), read it back, hand it to the control interrupt.
-async fn commit(page: &mut PageAssembler, crc: u32, running: Option<(Slot, u32)>) -> Result<(Slot, u32), Nack> {
+async fn commit(
+    bytes: &[u8; model_core::control::page::PAGE_BYTES],
+    img: &ConfigImage,
+    running: Option<(Slot, u32)>,
+) -> Result<(Slot, u32), Nack> {
     if controller::ENABLE.load(Ordering::Relaxed) {
         return Err(Nack::Busy);
     }
-    let (bytes, img) = page.commit(crc)?;
-    let (lp, cfg) = runnable(&img).map_err(|_| Nack::InvalidPage)?;
+    // Checked now, built again once written: a controller held across the flash waits
+    // would sit in both link tasks' futures (11 KB each with every model built in).
+    runnable(img).map(drop).map_err(|_| Nack::InvalidPage)?;
     let (slot, seq) = slots::commit_target(running);
     let image = slots::slot_image(bytes, seq).ok_or(Nack::InvalidPage)?;
     flash::program_slot(slot, &image).await.map_err(|e| {
@@ -500,7 +617,8 @@ async fn commit(page: &mut PageAssembler, crc: u32, running: Option<(Slot, u32)>
             return Err(Nack::Flash);
         }
     }
-    critical_section::with(|cs| controller::PENDING.borrow_ref_mut(cs).replace((lp, cfg)));
+    let built = runnable(img).map_err(|_| Nack::InvalidPage)?;
+    critical_section::with(|cs| controller::PENDING.borrow_ref_mut(cs).replace(built));
     // A board held by a damaged configuration runs again once a good page is committed.
     if DAMAGED.swap(false, Ordering::Relaxed) {
         controller::RESET.store(true, Ordering::Relaxed);

@@ -7,7 +7,7 @@
 
 use embassy_stm32::adc::{AdcChannel, AnyAdcChannel};
 use embassy_stm32::pac;
-use embassy_stm32::peripherals::{ADC1, FDCAN1, FLASH, IWDG, PA11, PA12, TIM1};
+use embassy_stm32::peripherals::{ADC1, FDCAN1, FLASH, IWDG, LPUART1, PA11, PA12, PA2, PA3, TIM1};
 use embassy_stm32::timer::complementary_pwm::ComplementaryPwmPin;
 use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::timer::{Ch1, Ch2};
@@ -26,8 +26,9 @@ pub const HSE_HZ: u32 = 24_000_000;
 pub const CAN_BITRATE: u32 = 1_000_000;
 pub const CAN_ID_CMD: u16 = 0x120;
 pub const CAN_ID_REPLY: u16 = 0x121;
-/// The host must be heard this often while the drive is enabled (`firmware::link`), ms.
-pub const COMMAND_TIMEOUT_MS: u64 = 100;
+pub use firmware::link::COMMAND_TIMEOUT_MS;
+/// The serial link's baud rate (`hil-sim board --port /dev/ttyACM0` uses the same).
+pub const UART_BAUD: u32 = 921_600;
 /// Independent watchdog timeout, µs.
 pub const WATCHDOG_US: u32 = 50_000;
 
@@ -48,12 +49,17 @@ pub struct Board {
     /// Owned so nothing else programs the flash ([`flash`] does, by register).
     pub flash: Peri<'static, FLASH>,
     pub iwdg: Peri<'static, IWDG>,
+    /// LPUART1 on the ST-LINK virtual COM port: PA2 TX, PA3 RX (the serial link).
+    pub uart: Peri<'static, LPUART1>,
+    pub uart_tx: Peri<'static, PA2>,
+    pub uart_rx: Peri<'static, PA3>,
 }
 
 impl Board {
     /// Nucleo-G474RE: TIM1 CH1/CH1N on PA8/PB13, CH2/CH2N on PA9/PB14 (the ST motor-control
     /// connector pins); Hall on PA0 (ADC1_IN1), coil current on PA1 (ADC1_IN2, also
-    /// COMP1_INP for the hardware trip), supply on PB1 (ADC1_IN12); FDCAN1 on PA11/PA12.
+    /// COMP1_INP for the hardware trip), supply on PB1 (ADC1_IN12); FDCAN1 on PA11/PA12;
+    /// LPUART1 on PA2/PA3 (the ST-LINK virtual COM port).
     pub fn new(p: Peripherals) -> Self {
         use embassy_stm32::gpio::OutputType::PushPull;
         Self {
@@ -69,6 +75,9 @@ impl Board {
             can_tx: p.PA12,
             flash: p.FLASH,
             iwdg: p.IWDG,
+            uart: p.LPUART1,
+            uart_tx: p.PA2,
+            uart_rx: p.PA3,
         }
     }
 }

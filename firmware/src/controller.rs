@@ -20,68 +20,12 @@ use embassy_stm32::adc::InjectedAdc;
 use embassy_stm32::interrupt;
 use embassy_stm32::peripherals::{ADC1, TIM1};
 use embassy_stm32::timer::complementary_pwm::ComplementaryPwm;
-use model_core::control::{
-    ConfigImage, ControlInput, ControlOutput, ControlState, ControlStep, PageError, ValidatedConfig,
-};
-use model_core::models::{algebraic, bouc_wen, lugre, tanh};
-use model_core::Model;
+use model_core::control::{ControlInput, ControlOutput, ValidatedConfig};
 
 use firmware::bridge::{self, Bridge};
+pub use firmware::runner::Loop;
 
 use crate::board;
-
-/// The models this firmware is built with (any page for another model is refused).
-pub enum Loop {
-    Algebraic(ControlStep<algebraic::Algebraic>, ControlState<()>),
-    BoucWen(ControlStep<bouc_wen::BoucWen>, ControlState<bouc_wen::State>),
-    LuGre(ControlStep<lugre::LuGre>, ControlState<lugre::State>),
-    Tanh(ControlStep<tanh::Tanh>, ControlState<()>),
-}
-
-fn make<M: Model>(img: &ConfigImage) -> Result<(ControlStep<M>, ControlState<M::State>), PageError> {
-    let rate = img.rate.build(img.control.get().dt).map_err(PageError::Invalid)?;
-    let step = ControlStep::new(img.model::<M>()?, rate).map_err(PageError::Invalid)?;
-    let state = step.state();
-    Ok((step, state))
-}
-
-impl Loop {
-    /// The controller a page describes, validated (model parameters by `from_params`).
-    pub fn from_image(img: &ConfigImage) -> Result<Self, PageError> {
-        // The ids are the models' own (`Model::ID`, registered in model-core's registry).
-        let id = img.model_id();
-        if id == algebraic::Algebraic::ID {
-            make(img).map(|(s, st)| Self::Algebraic(s, st))
-        } else if id == bouc_wen::BoucWen::ID {
-            make(img).map(|(s, st)| Self::BoucWen(s, st))
-        } else if id == lugre::LuGre::ID {
-            make(img).map(|(s, st)| Self::LuGre(s, st))
-        } else if id == tanh::Tanh::ID {
-            make(img).map(|(s, st)| Self::Tanh(s, st))
-        } else {
-            Err(PageError::WrongModel)
-        }
-    }
-
-    fn slow(&mut self, cfg: &ValidatedConfig, temperature: f32) {
-        match self {
-            Self::Algebraic(s, st) => s.slow(cfg, st, temperature),
-            Self::BoucWen(s, st) => s.slow(cfg, st, temperature),
-            Self::LuGre(s, st) => s.slow(cfg, st, temperature),
-            Self::Tanh(s, st) => s.slow(cfg, st, temperature),
-        }
-    }
-
-    #[inline(always)]
-    fn step(&mut self, cfg: &ValidatedConfig, x: ControlInput) -> ControlOutput {
-        match self {
-            Self::Algebraic(s, st) => s.step(cfg, st, x),
-            Self::BoucWen(s, st) => s.step(cfg, st, x),
-            Self::LuGre(s, st) => s.step(cfg, st, x),
-            Self::Tanh(s, st) => s.step(cfg, st, x),
-        }
-    }
-}
 
 /// The compiled-in configuration ([`firmware::bringup::default_image`]).
 pub use firmware::bringup::default_image;
@@ -153,6 +97,71 @@ pub static TELEMETRY: Mutex<Cell<Snapshot>> = Mutex::new(Cell::new(Snapshot {
     supply_v: 0.0,
     cycles: 0,
 }));
+
+/// One control sample for the serial link's telemetry stream (raw step output; the serial
+/// task numbers and encodes it).
+#[derive(Clone, Copy, Default)]
+pub struct StreamSample {
+    /// Sample index since start-up.
+    pub n: u32,
+    pub out: ControlOutput,
+    pub reference: f32,
+}
+
+/// Samples waiting for the serial task; a full ring drops the newest (the host sees the
+/// gap in the sequence numbers).
+pub struct StreamRing {
+    buf: [StreamSample; STREAM_RING],
+    head: usize,
+    len: usize,
+}
+
+const STREAM_RING: usize = 16;
+
+impl StreamRing {
+    const fn new() -> Self {
+        Self { buf: [StreamSample { n: 0, out: EMPTY_OUTPUT, reference: 0.0 }; STREAM_RING], head: 0, len: 0 }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, s: StreamSample) {
+        if self.len < STREAM_RING {
+            if let Some(slot) = self.buf.get_mut((self.head + self.len) % STREAM_RING) {
+                *slot = s;
+                self.len += 1;
+            }
+        }
+    }
+
+    /// The oldest sample.
+    pub fn pop(&mut self) -> Option<StreamSample> {
+        if self.len == 0 {
+            return None;
+        }
+        let s = self.buf.get(self.head).copied();
+        self.head = (self.head + 1) % STREAM_RING;
+        self.len -= 1;
+        s
+    }
+}
+
+/// Every `STREAM_DECIMATION`-th sample goes to [`STREAM`] (0: none); set by the serial task.
+pub static STREAM_DECIMATION: AtomicU32 = AtomicU32::new(0);
+pub static STREAM: Mutex<RefCell<StreamRing>> = Mutex::new(RefCell::new(StreamRing::new()));
+
+const EMPTY_OUTPUT: ControlOutput = ControlOutput {
+    duty: 0.0,
+    compare: 0,
+    pwm_enable: false,
+    b: 0.0,
+    current: 0.0,
+    torque_est: 0.0,
+    i_ref: 0.0,
+    v_cmd: 0.0,
+    mode: model_core::control::Mode::Init,
+    fault: model_core::control::FaultCode::None,
+    flags: 0,
+};
 
 /// Rate of the slow supervisor pass (the step trips `SupervisorStalled` after 0.1 s
 /// without one).
@@ -257,6 +266,10 @@ fn ADC1_2() {
         }
         if n.is_multiple_of(TELEMETRY_DECIMATION) {
             TELEMETRY.borrow(cs).set(Snapshot { out, reference, supply_v, cycles });
+        }
+        let d = STREAM_DECIMATION.load(Ordering::Relaxed);
+        if d != 0 && n.is_multiple_of(d) {
+            STREAM.borrow_ref_mut(cs).push(StreamSample { n, out, reference });
         }
         // The slow pass after the compare write (the board has no temperature sensor:
         // NaN, no compensation).

@@ -10,10 +10,12 @@
 //!   configuration against the timer, the reset cause, the compiled-in configuration.
 //! - [`bridge`]: when the main output may be enabled (compare values first, MOE a period
 //!   later) and the latched stall.
+//! - [`runner`]: the controller of a page, for every model that maps the field to torque.
 #![cfg_attr(not(test), no_std)]
 
 pub mod bridge;
 pub mod bringup;
 pub mod can_timing;
 pub mod link;
+pub mod runner;
 pub mod slots;

@@ -5,6 +5,9 @@
 //! `Enable` command re-arms it.
 
 /// Tracks when the host was last heard.
+/// The host must be heard this often while the drive is enabled, ms.
+pub const COMMAND_TIMEOUT_MS: u64 = 100;
+
 #[derive(Clone, Copy, Debug)]
 pub struct LinkWatch {
     timeout_ms: u64,

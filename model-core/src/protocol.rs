@@ -11,8 +11,10 @@
 //! | `0x02` | enable | u8: 1 drive, 0 bridge off | ack |
 //! | `0x03` | reset | – (clears a latched fault, recalibrates) | ack |
 //! | `0x04` | get status | – | status |
+//! | `0x05` | telemetry | u16 decimation (every n-th control sample; 0 stops) | ack; then [`telemetry`] frames |
 //! | `0x10` | config begin | u16 page length (≤ 2048) | ack |
 //! | `0x11` | config data | u16 offset, 1–5 bytes | none (nack on a bad offset) |
+//! | `0x13` | config query | – | page CRC (u32 CRC-32 of the running page's bytes through its own CRC; 0: compiled-in defaults) |
 //! | `0x12` | config commit | u32 CRC-32 of the transferred bytes | ack after it is validated, written to flash and swapped in; nack otherwise |
 //!
 //! Replies: `0x81` status (u8 mode, u8 fault code, u8 overruns (saturating), f32 torque
@@ -21,7 +23,16 @@
 //! answers on its reply identifier (see the firmware README); a configuration is only
 //! accepted while the bridge is off.
 
+//!
+//! On a byte stream (the UART link, TCP for the virtual board) every frame is framed by
+//! [`frame`] (COBS, CRC-32); [`device`] is the board's command handling, [`telemetry`] the
+//! signal stream (UART/TCP only: its frames are longer than a CAN frame).
+
 use crate::control::page::{ConfigImage, PageError, PAGE_BYTES};
+
+pub mod device;
+pub mod frame;
+pub mod telemetry;
 
 /// Largest frame.
 pub const FRAME: usize = 8;
@@ -35,9 +46,11 @@ pub enum Command {
     Enable(bool),
     Reset,
     GetStatus,
+    Telemetry { decimation: u16 },
     ConfigBegin { len: u16 },
     ConfigData { offset: u16, len: u8, data: [u8; CHUNK] },
     ConfigCommit { crc: u32 },
+    ConfigQuery,
 }
 
 /// Why a frame or a request was refused.
@@ -72,6 +85,8 @@ pub enum Response {
     },
     Ack(u8),
     Nack(u8, Nack),
+    /// CRC-32 of the running page (`0x84`).
+    PageCrc(u32),
 }
 
 fn le4(b: &[u8]) -> Option<[u8; 4]> {
@@ -89,9 +104,11 @@ impl Command {
             Self::Enable(_) => 0x02,
             Self::Reset => 0x03,
             Self::GetStatus => 0x04,
+            Self::Telemetry { .. } => 0x05,
             Self::ConfigBegin { .. } => 0x10,
             Self::ConfigData { .. } => 0x11,
             Self::ConfigCommit { .. } => 0x12,
+            Self::ConfigQuery => 0x13,
         }
     }
 
@@ -109,6 +126,7 @@ impl Command {
             (0x02, [e]) if *e <= 1 => Self::Enable(*e == 1),
             (0x03, []) => Self::Reset,
             (0x04, []) => Self::GetStatus,
+            (0x05, [a, b]) => Self::Telemetry { decimation: u16::from_le_bytes([*a, *b]) },
             (0x10, [a, b]) => Self::ConfigBegin { len: u16::from_le_bytes([*a, *b]) },
             (0x11, [a, b, data @ ..]) if !data.is_empty() && data.len() <= CHUNK => {
                 let mut d = [0u8; CHUNK];
@@ -118,7 +136,8 @@ impl Command {
                 Self::ConfigData { offset: u16::from_le_bytes([*a, *b]), len: data.len() as u8, data: d }
             }
             (0x12, r) => Self::ConfigCommit { crc: u32::from_le_bytes(le4(r).ok_or(Nack::Malformed)?) },
-            (0x01..=0x04 | 0x10..=0x12, _) => return Err(Nack::Malformed),
+            (0x13, []) => Self::ConfigQuery,
+            (0x01..=0x05 | 0x10..=0x13, _) => return Err(Nack::Malformed),
             _ => return Err(Nack::Unknown),
         })
     }
@@ -130,7 +149,8 @@ impl Command {
         match *self {
             Self::SetTorque(v) => w.put(&v.to_le_bytes()),
             Self::Enable(e) => w.put(&[u8::from(e)]),
-            Self::Reset | Self::GetStatus => {}
+            Self::Reset | Self::GetStatus | Self::ConfigQuery => {}
+            Self::Telemetry { decimation } => w.put(&decimation.to_le_bytes()),
             Self::ConfigBegin { len } => w.put(&len.to_le_bytes()),
             Self::ConfigData { offset, len, data } => {
                 w.put(&offset.to_le_bytes());
@@ -169,6 +189,10 @@ impl Response {
             }
             Self::Ack(cmd) => w.put(&[0x82, cmd]),
             Self::Nack(cmd, why) => w.put(&[0x83, cmd, why as u8]),
+            Self::PageCrc(crc) => {
+                w.put(&[0x84]);
+                w.put(&crc.to_le_bytes());
+            }
         }
         w.n
     }
@@ -183,6 +207,7 @@ impl Response {
                 torque_est: f32::from_le_bytes([*t0, *t1, *t2, *t3]),
             },
             [0x82, cmd] => Self::Ack(*cmd),
+            [0x84, a, b, c, d] => Self::PageCrc(u32::from_le_bytes([*a, *b, *c, *d])),
             [0x83, cmd, why] => Self::Nack(
                 *cmd,
                 match why {
@@ -248,6 +273,11 @@ impl PageAssembler {
             }
             _ => Err(Nack::Sequence),
         }
+    }
+
+    /// The page bytes received (0xFF beyond what was sent).
+    pub fn bytes(&self) -> &[u8; PAGE_BYTES] {
+        &self.buf
     }
 
     /// End the transfer: the bytes must match `crc` (CRC-32 of the `len` bytes sent), then

@@ -3,7 +3,7 @@
 Modelled from RM0440, only what embassy-stm32's init and the firmware touch: RCC/PWR/FLASH
 ready bits, GPIO, TIM1 (update event = TRGO2, compare registers, MOE, break), TIM15 (the
 time driver: counter, CC and update flags), ADC1's injected sequence and its interrupt,
-FDCAN1's init handshake and message RAM (Rx FIFO 0, Tx buffers), IWDG (reset on expiry),
+FDCAN1's init handshake and message RAM (Rx FIFO 0, Tx buffers), LPUART1 as storage, IWDG (reset on expiry),
 flash program/erase with their timing and ECC on half-programmed double-words, and the
 core's NVIC/SCB/DWT. Any access to an address no model claims raises `Unmodelled`: a new
 peripheral use cannot slip through.
@@ -501,6 +501,9 @@ class Machine:
         self.periph = [
             self.rcc, self.flash, self.tim1, self.tim15, self.adc, self.can, self.iwdg,
             window("PWR", 0x4000_7000, 0x400, {0x14: 0}),
+            # LPUART1 (the serial link): configured, never spoken to here; ISR reads
+            # transmitter/receiver enabled and an empty transmit register.
+            window("LPUART1", 0x4000_8000, 0x400, {0x1C: 0x0060_00C0}),
             window("GPIOA", 0x4800_0000, 0x400, {0x00: 0xABFF_FFFF}),
             window("GPIOB", 0x4800_0400, 0x400, {0x00: 0xFFFF_FEBF}),
             window("GPIOC", 0x4800_0800, 0x400, {0x00: 0xFFFF_FFFF}),

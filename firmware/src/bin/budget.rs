@@ -151,6 +151,13 @@ mod bench {
         }
     }
 
+    /// A model that maps the field to torque: its step, then the firmware's control step
+    /// with it (`control_step_<id>`).
+    fn clutch<M: Model>(flat: &[f32], sw: Sweep) {
+        model::<M>(flat, sw);
+        control_of::<M>(flat);
+    }
+
     const fn sw(amp: f32, off: f32) -> Sweep {
         Sweep { amp, off, u_off: 0.0, u_amp: 0.0 }
     }
@@ -169,10 +176,10 @@ mod bench {
 
     fn models() {
         // Seed 000 (clutch, B in mT as fitted there): Table 6, 3 (Wen's naming), 4, 5 averages.
-        model::<algebraic::Registered>(&[4.606, -0.076, 0.033, 0.797], sw(1.5, 0.0));
-        model::<bouc_wen::Registered>(&[2.162, 0.400, 1.0, -1.486, 1.0, -0.077, 5.861, 0.0], sw(1.5, 0.0));
-        model::<lugre::Registered>(&[4.312, 5.771, 0.003, -0.151, 4.297, 5.225], sw(1.5, 0.0));
-        model::<tanh::Registered>(&[0.495, 1.969, 1.603, -0.120, 4.790, 0.587], sw(1.5, 0.0));
+        clutch::<algebraic::Registered>(&[4.606, -0.076, 0.033, 0.797], sw(1.5, 0.0));
+        clutch::<bouc_wen::Registered>(&[2.162, 0.400, 1.0, -1.486, 1.0, -0.077, 5.861, 0.0], sw(1.5, 0.0));
+        clutch::<lugre::Registered>(&[4.312, 5.771, 0.003, -0.151, 4.297, 5.225], sw(1.5, 0.0));
+        clutch::<tanh::Registered>(&[0.495, 1.969, 1.603, -0.120, 4.790, 0.587], sw(1.5, 0.0));
 
         // Hammerstein–Wiener: nets from a pattern, poles at 0.5 (stable), range ±10.
         const HW: usize = hammerstein_wiener::Registered::N_PARAMS;
@@ -182,7 +189,7 @@ mod bench {
         p[f..f + 5].copy_from_slice(&[-2.5, 2.5, -1.25, 0.3125, -0.03125]);
         p[f + 5 + 3 * 13 + 2] = -10.0;
         p[f + 5 + 3 * 13 + 3] = 10.0;
-        model::<hammerstein_wiener::Registered>(&p, sw(1.5, 0.0));
+        clutch::<hammerstein_wiener::Registered>(&p, sw(1.5, 0.0));
 
         // The board's NARX (8 units, 86 values; `BUDGETS` row `narx`).
         const NX: usize = narx::Registered::N_PARAMS;
@@ -191,7 +198,7 @@ mod bench {
         p[..4].copy_from_slice(&[0.0, 1.0, 0.0, 1.0]);
         p[NX - 2] = -50.0;
         p[NX - 1] = 50.0;
-        model::<narx::Registered>(&p, sw(1.5, 0.0));
+        clutch::<narx::Registered>(&p, sw(1.5, 0.0));
 
         // Dampers (x in cm, command in A or V).
         model::<bingham::Registered>(&[50.0, 10.0, 5.0, 1.0, 10.0, 0.5, 0.2, 0.1, 0.05, 1.0], swu(1.0, 0.0, 0.0, 2.0));
@@ -199,7 +206,7 @@ mod bench {
             &[21.0, 3.5, 46.9, 283.0, 2.95, 5.0, 14.3, 140.0, 695.0, 363.0, 363.0, 301.0, 2.0, 190.0],
             swu(1.0, 0.0, 0.0, 2.0),
         );
-        model::<dahl::Registered>(&[50.0, 20.0, 300.0, 200.0, 5.0, 10.0, 2.0, 30.0], swu(1.0, 0.0, 0.0, 2.0));
+        clutch::<dahl::Registered>(&[50.0, 20.0, 300.0, 200.0, 5.0, 10.0, 2.0, 30.0], swu(1.0, 0.0, 0.0, 2.0));
         let at = [10.0, 5.0, 400.0, 20.0, 300.0, 50.0, 30.0, 1.0, 0.5, 0.01];
         model::<arctan::Registered>(&at, swu(1.0, 0.0, 0.0, 2.0));
         let mut ai = [0.0f32; 11];
@@ -216,7 +223,7 @@ mod bench {
         );
 
         // Seed 004 (operator models), input in [−1, 1].
-        model::<preisach::Registered>(&[1.0, 2.0, 0.1, 0.05, 0.1, 1.0, -1.0, 1.0, 0.0], sw(0.9, 0.0));
+        clutch::<preisach::Registered>(&[1.0, 2.0, 0.1, 0.05, 0.1, 1.0, -1.0, 1.0, 0.0], sw(0.9, 0.0));
         let mut p = [0.0f32; 22];
         p[0] = 1.0;
         p[1] = 0.05;
@@ -224,8 +231,8 @@ mod bench {
             p[2 + i] = 0.1 * i as f32;
             p[12 + i] = 0.5 / (1.0 + i as f32);
         }
-        model::<prandtl_ishlinskii::Registered>(&p, sw(0.9, 0.0));
-        model::<gpi::Registered>(&[1.0, 0.1, 1.0, 1.0, 1.0, 0.5, 0.2, 1.0, 0.5, 0.2, -1.0, 1.0, 0.0], sw(0.9, 0.0));
+        clutch::<prandtl_ishlinskii::Registered>(&p, sw(0.9, 0.0));
+        clutch::<gpi::Registered>(&[1.0, 0.1, 1.0, 1.0, 1.0, 0.5, 0.2, 1.0, 0.5, 0.2, -1.0, 1.0, 0.0], sw(0.9, 0.0));
         let mut p = [0.0f32; 22];
         p[0] = 0.1;
         for i in 0..10 {
@@ -233,20 +240,43 @@ mod bench {
             p[11 + i] = 0.1 * (1.0 + i as f32);
         }
         p[21] = 0.2;
-        model::<maxwell_slip::Registered>(&p, sw(0.9, 0.0));
-        model::<bouc_wen_asym::Registered>(&[0.5, 1.0, 1.0, 1.0, 0.5, 0.5, 1.0, 0.0, 0.5, 0.5, 0.5, 1.0], sw(0.9, 0.0));
+        clutch::<maxwell_slip::Registered>(&p, sw(0.9, 0.0));
+        clutch::<bouc_wen_asym::Registered>(
+            &[0.5, 1.0, 1.0, 1.0, 0.5, 0.5, 1.0, 0.0, 0.5, 0.5, 0.5, 1.0],
+            sw(0.9, 0.0),
+        );
     }
 
-    type Step = ControlStep<algebraic::Algebraic>;
-    type StepFn = fn(&Step, &ValidatedConfig, &mut ControlState<()>, ControlInput) -> ControlOutput;
-    type SlowFn = fn(&Step, &ValidatedConfig, &mut ControlState<()>, f32);
+    type StepOf<M> =
+        fn(&ControlStep<M>, &ValidatedConfig, &mut ControlState<<M as Model>::State>, ControlInput) -> ControlOutput;
+    type SlowOf<M> = fn(&ControlStep<M>, &ValidatedConfig, &mut ControlState<<M as Model>::State>, f32);
 
-    /// The firmware's control step with its compiled-in default model (the algebraic model
-    /// in T, as `hil-sim loop` identifies it) against a crude RL coil with B ∝ i.
-    fn control_step() {
-        let Ok(model) = algebraic::Algebraic::new(20.0, -0.05, -10.0, 0.8, DT) else { fail("control model") };
+    /// The control step of model `M` (as `firmware::runner::Loop` runs it) over the same
+    /// sequence as [`control_step`], reported as `control_step_<id>` (and its slow pass as
+    /// `supervisor_slow_<id>`: it steps the model too, for the feed-forward's linearisation).
+    fn control_of<M: Model>(flat: &[f32]) {
+        let Ok(model) = M::from_params(flat, DT) else { fail(M::ID) };
         let Ok(rate) = RateParams::filtered(DT, 150.0) else { fail("rate") };
         let Ok(step) = ControlStep::new(model, rate) else { fail("control step") };
+        let f: StepOf<M> = black_box(ControlStep::<M>::step);
+        let slow: SlowOf<M> = black_box(ControlStep::<M>::slow);
+        hprintln!("step control_step_{} {:#x} {}", M::ID, f as usize, N);
+        hprintln!("step supervisor_slow_{} {:#x} {}", M::ID, slow as usize, N.div_ceil(SLOW));
+        let cfg = control_config();
+        let mut s = step.state();
+        drive_sequence(|k, input| {
+            if k % SLOW == 0 {
+                slow(black_box(&step), black_box(&cfg), &mut s, black_box(40.0));
+            }
+            black_box(f(black_box(&step), black_box(&cfg), &mut s, black_box(input)))
+        });
+    }
+
+    const N: u32 = 440;
+    /// The slow pass runs before every `SLOW`-th sample (1 kHz at 20 kHz).
+    const SLOW: u32 = 20;
+
+    fn control_config() -> ValidatedConfig {
         let cfg = ControlConfig {
             mode: LoopMode::Torque,
             calib_samples: 8.0,
@@ -257,16 +287,14 @@ mod bench {
             ..ControlConfig::defaults(DT)
         };
         let Ok(cfg) = cfg.validate() else { fail("control config") };
-        let f: StepFn = black_box(Step::step);
-        let slow: SlowFn = black_box(Step::slow);
-        const N: u32 = 440;
-        /// The slow pass runs before every `SLOW`-th sample (1 kHz at 20 kHz).
-        const SLOW: u32 = 20;
-        hprintln!("step control_step {:#x} {}", f as usize, N);
-        hprintln!("step supervisor_slow {:#x} {}", slow as usize, N.div_ceil(SLOW));
-        let mut s = step.state();
+        cfg
+    }
+
+    /// The control step's input sequence against a crude RL coil with B ∝ i: `f(k, input)`
+    /// runs sample `k` and returns the step's output.
+    fn drive_sequence(mut f: impl FnMut(u32, ControlInput) -> ControlOutput) {
+        let c = *control_config().get();
         let (r_coil, l_coil, supply) = (4.0f32, 0.02f32, 24.0f32);
-        let c = *cfg.get();
         let mut i = 0.0f32;
         for k in 0..N {
             let t = k as f32 * DT;
@@ -292,13 +320,34 @@ mod bench {
                 reset: k == 390,
                 ..ControlInput::new(hall, current, supply, if k == 200 { 30.0 } else { reference })
             };
-            if k % SLOW == 0 {
-                slow(black_box(&step), black_box(&cfg), &mut s, black_box(40.0));
-            }
-            let o = black_box(f(black_box(&step), black_box(&cfg), &mut s, black_box(input)));
+            let o = f(k, input);
             let v = if o.pwm_enable { o.duty * supply } else { 0.0 };
             i += DT * (v - r_coil * i) / l_coil;
         }
+    }
+
+    type Step = ControlStep<algebraic::Algebraic>;
+    type StepFn = fn(&Step, &ValidatedConfig, &mut ControlState<()>, ControlInput) -> ControlOutput;
+    type SlowFn = fn(&Step, &ValidatedConfig, &mut ControlState<()>, f32);
+
+    /// The firmware's control step with its compiled-in default model (the algebraic model
+    /// in T, as `hil-sim loop` identifies it) against a crude RL coil with B ∝ i.
+    fn control_step() {
+        let Ok(model) = algebraic::Algebraic::new(20.0, -0.05, -10.0, 0.8, DT) else { fail("control model") };
+        let Ok(rate) = RateParams::filtered(DT, 150.0) else { fail("rate") };
+        let Ok(step) = ControlStep::new(model, rate) else { fail("control step") };
+        let cfg = control_config();
+        let f: StepFn = black_box(Step::step);
+        let slow: SlowFn = black_box(Step::slow);
+        hprintln!("step control_step {:#x} {}", f as usize, N);
+        hprintln!("step supervisor_slow {:#x} {}", slow as usize, N.div_ceil(SLOW));
+        let mut s = step.state();
+        drive_sequence(|k, input| {
+            if k % SLOW == 0 {
+                slow(black_box(&step), black_box(&cfg), &mut s, black_box(40.0));
+            }
+            black_box(f(black_box(&step), black_box(&cfg), &mut s, black_box(input)))
+        });
     }
 
     #[entry]

@@ -2,6 +2,7 @@
 //! then stdout carries exactly one JSON object; progress and logs go to stderr.
 
 mod accuracy;
+mod board;
 mod budget;
 mod compare;
 mod demo;
@@ -13,6 +14,7 @@ mod models;
 mod progress;
 mod replay;
 mod simulate;
+mod virtual_board;
 
 use std::path::PathBuf;
 
@@ -52,6 +54,10 @@ pub enum Cmd {
     Budget(budget::BudgetArgs),
     /// Write a parameter file (`fit --save`) as the firmware's flash configuration page.
     Export(export::ExportArgs),
+    /// Talk to a clutch driver: status, enable/disable, reset, torque, load, record.
+    Board(board::BoardArgs),
+    /// The firmware's application on the host against the simulated clutch, on a TCP port.
+    VirtualBoard(virtual_board::VirtualBoardArgs),
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
@@ -67,6 +73,8 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Cmd::Loop(a) => loop_cmd::run_cmd(a),
         Cmd::Budget(a) => budget::run(a),
         Cmd::Export(a) => export::run(a),
+        Cmd::Board(a) => board::run(a),
+        Cmd::VirtualBoard(a) => virtual_board::run(a),
     }
 }
 

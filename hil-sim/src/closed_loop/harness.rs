@@ -2,13 +2,14 @@
 //! the next sample on (one-sample computation delay), the plant integrating every PWM edge
 //! in between; the slow supervisor pass at 1 kHz. Times in s, torques in N·m, B in T.
 
-use model_core::control::{ControlInput, ControlStep, FaultCode, ValidatedConfig};
+use model_core::control::{ControlStep, ValidatedConfig};
 use model_core::Model;
 use serde::Serialize;
 
-use super::injection::{Injection, Schedule};
+use super::injection::Schedule;
+use super::rig::{Command, Rig, Stepped};
 use crate::numerics::metrics::{metrics, Metrics};
-use crate::sim::plant::{ClutchParams, Plant};
+use crate::sim::plant::ClutchParams;
 
 /// Time the loop gets before the reference starts (calibration 0.1 s + margin), s.
 pub const T_START: f64 = 0.15;
@@ -79,49 +80,28 @@ pub fn run<M: Model>(
 ) -> Run {
     let dt = f64::from(cfg.get().dt);
     let n = (duration / dt).round() as usize;
-    let mut plant = Plant::new(clutch.clone(), seed);
-    let mut st = step.state();
-    let mut applied = (0.0f64, false);
+    let mut rig = Rig::new(clutch, &cfg, seed, fault);
+    let mut ctrl = Stepped(step, step.state());
     let mut out = Run::default();
-    let mut injected = false;
-    let use_temp = cfg.get().temp_coeff != 0.0;
-    // The slow supervisor pass at 1 kHz, as the firmware's `supervisor` task runs it.
-    let slow_every = ((1e-3 / dt).round() as usize).max(1);
     for k in 0..n {
         let t = k as f64 * dt;
-        let active = fault.filter(|f| t >= f.at).map(|f| f.injection);
-        if let (Some(inj), false) = (active, injected) {
-            injected = true;
-            inj.apply(clutch, &mut plant, &mut cfg);
-        }
-        let overrun = active == Some(Injection::Overrun);
-        let m = plant.measure();
         let r = if t >= T_START { reference(t - T_START) } else { 0.0 };
-        if k % slow_every == 0 {
-            step.slow(&cfg, &mut st, if use_temp { m.temperature as f32 } else { f32::NAN });
-        }
-        let input = ControlInput { overrun, ..ControlInput::new(m.hall, m.current, m.supply_v as f32, r as f32) };
-        let o = step.step(&cfg, &mut st, input);
-        out.t.push(t);
+        let s = rig.sample(&mut ctrl, &mut cfg, Command { reference: r, enable: true, reset: false });
+        let o = s.out;
+        out.t.push(s.t);
         out.reference.push(r);
         out.torque_est.push(f64::from(o.torque_est));
-        out.torque_true.push(plant.torque);
-        out.load_cell.push(plant.load_cell);
+        out.torque_true.push(s.torque_true);
+        out.load_cell.push(s.load_cell);
         out.b.push(f64::from(o.b));
         out.current.push(f64::from(o.current));
-        out.coil_current.push(plant.coil.i);
+        out.coil_current.push(s.coil_current);
         out.i_ref.push(f64::from(o.i_ref));
-        out.duty.push(applied.0);
-        out.speed.push(plant.omega);
-        out.temperature.push(plant.theta);
+        out.duty.push(s.applied.0);
+        out.speed.push(s.speed);
+        out.temperature.push(s.temperature);
         out.fault.push(o.fault.code());
-        out.pwm_enable.push(applied.1);
-        plant.advance(applied.0, applied.1, dt);
-        // An overrunning step delivers its duty late: the old one stays for this period,
-        // except that a tripped supervisor's safe state is applied at once.
-        if !overrun || o.fault != FaultCode::None {
-            applied = (f64::from(o.duty), o.pwm_enable);
-        }
+        out.pwm_enable.push(s.applied.1);
     }
     out
 }

@@ -28,21 +28,16 @@ pub enum PageBuildError {
     Page { path: PathBuf, source: PageError },
     #[error("default control settings at {control_hz} Hz: {source}")]
     Control { control_hz: f32, source: ParamError },
-    #[error("{}: model `{model}`: the firmware runs only {} (it refuses any other page)", path.display(), FIRMWARE_MODELS.join(", "))]
-    NotInFirmware { path: PathBuf, model: String },
+    #[error("{}: model `{model}`: the firmware runs only {} ({why})", path.display(), FIRMWARE_MODELS.join(", "))]
+    NotInFirmware { path: PathBuf, model: String, why: &'static str },
     #[error("{}: {model} parameters give a torque of {value:.3e} on a representative flux sweep (±{TRIAL_B} T); \
              the firmware's f32 control step cannot use them", path.display())]
     Absurd { path: PathBuf, model: String, value: f32 },
 }
 
-/// The models the firmware is built with (`firmware/src/controller.rs`, `Loop`): a page
-/// for any other model is refused there (`PageError::WrongModel`), so it is refused here.
-pub const FIRMWARE_MODELS: [&str; 4] = [
-    model_core::models::algebraic::Algebraic::ID,
-    model_core::models::bouc_wen::BoucWen::ID,
-    model_core::models::lugre::LuGre::ID,
-    model_core::models::tanh::Tanh::ID,
-];
+/// The models the firmware is built with (`firmware::runner::Loop`): a page for any other
+/// model is refused there (`PageError::WrongModel`), so it is refused here.
+pub const FIRMWARE_MODELS: [&str; firmware::runner::MODELS.len()] = firmware::runner::MODELS;
 
 /// Peak flux density of the trial sweep, T.
 const TRIAL_B: f32 = 1.5;
@@ -107,7 +102,12 @@ pub fn image(file: &ParamsFile, path: &Path, control: ValidatedConfig) -> Result
 /// its model ([`FIRMWARE_MODELS`]): what `export` writes.
 pub fn firmware_image(file: &ParamsFile, path: &Path, control: ValidatedConfig) -> Result<ConfigImage, PageBuildError> {
     if !FIRMWARE_MODELS.contains(&file.model.as_str()) {
-        return Err(PageBuildError::NotInFirmware { path: path.to_owned(), model: file.model.clone() });
+        let why = if file.model == model_core::models::preisach::Registered::ID {
+            "its 50 x 50 weight table, built by value, does not fit the board's stack when a page is committed or booted"
+        } else {
+            "this is a damper model, force from displacement and a command, which the clutch board cannot run"
+        };
+        return Err(PageBuildError::NotInFirmware { path: path.to_owned(), model: file.model.clone(), why });
     }
     image(file, path, control)
 }

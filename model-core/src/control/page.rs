@@ -191,6 +191,14 @@ impl ConfigImage {
         M::from_params(self.params(), self.control.get().dt).map_err(PageError::Invalid)
     }
 
+    /// The CRC-32 the page carries (over its header and words, as [`ConfigImage::encode`]
+    /// writes it): what `export` prints and what the board reports for its running page.
+    pub fn crc(&self) -> u32 {
+        let bytes = self.encode();
+        let len = usize::from(u16::from_le_bytes([bytes[6], bytes[7]]));
+        bytes.get(len..len + 4).and_then(|b| <[u8; 4]>::try_from(b).ok()).map_or(0, u32::from_le_bytes)
+    }
+
     /// The page bytes.
     pub fn encode(&self) -> [u8; PAGE_BYTES] {
         let mut out = [0xFFu8; PAGE_BYTES];

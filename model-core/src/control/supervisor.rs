@@ -70,6 +70,26 @@ pub enum FaultCode {
 
 impl FaultCode {
     /// Numeric code.
+    /// Every code, in code order.
+    pub const ALL: [Self; 16] = [
+        Self::None,
+        Self::HallOpen,
+        Self::HallShort,
+        Self::HallStuck,
+        Self::HallNoise,
+        Self::CoilOpen,
+        Self::OverCurrent,
+        Self::SupplyLow,
+        Self::SupplyHigh,
+        Self::ConfigCrc,
+        Self::ModelNonFinite,
+        Self::Overrun,
+        Self::CalibrationFailed,
+        Self::BImplausible,
+        Self::ConfigMismatch,
+        Self::SupervisorStalled,
+    ];
+
     pub const fn code(self) -> u8 {
         self as u8
     }

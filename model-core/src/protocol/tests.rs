@@ -1,4 +1,4 @@
-#![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::panic)]
+#![allow(clippy::unwrap_used, clippy::expect_used, clippy::indexing_slicing, clippy::panic)]
 use super::*;
 use crate::control::page::RateSpec;
 use crate::control::ControlConfig;
@@ -70,4 +70,65 @@ fn a_page_over_the_wire() {
     assert_eq!(back, img);
     assert_eq!(bytes[..], page[..]);
     assert_eq!(a.commit(crc).unwrap_err(), Nack::Sequence, "one commit per transfer");
+}
+
+#[test]
+fn frames_round_trip_through_cobs_and_resync_after_garbage() {
+    use super::frame::{encode, Deframer, FrameError, MAX_ENCODED};
+    let payloads: [&[u8]; 4] = [&[0x04], &[0, 0, 0, 0], &[0x01, 0, 0, 0x80, 0x3f], &[0xff; 40]];
+    let mut d = Deframer::default();
+    for p in payloads {
+        let mut out = [0u8; MAX_ENCODED];
+        let n = encode(p, &mut out);
+        assert!(n > p.len() + 4 && out[..n - 1].iter().all(|b| *b != 0) && out[n - 1] == 0);
+        // Garbage first (ends in a delimiter): dropped, never returned as a payload.
+        let mut got = None;
+        for b in [0x13, 0x77, 0x00].iter().chain(&out[..n]) {
+            if let Some(r) = d.push(*b) {
+                got = Some(r.map(<[u8]>::to_vec));
+            }
+        }
+        assert_eq!(got, Some(Ok(p.to_vec())));
+        // One byte flipped: the frame fails its CRC (or its COBS) and is dropped.
+        let mut bad = out;
+        bad[1] ^= 0x5a;
+        let last = bad[..n].iter().filter_map(|b| d.push(*b).map(|r| r.map(<[u8]>::to_vec))).last();
+        assert!(matches!(last, Some(Err(FrameError::Crc | FrameError::Cobs | FrameError::Short))), "{last:?}");
+    }
+}
+
+#[test]
+fn telemetry_round_trips_and_counts_losses() {
+    use super::telemetry::{lost_between, Telemetry};
+    let t = Telemetry {
+        t_us: 123_456,
+        b: 0.4,
+        current: 1.5,
+        torque_est: 7.25,
+        reference: 8.0,
+        duty: -0.3,
+        mode: 2,
+        fault: 1,
+        torque_true: f32::NAN,
+    };
+    let (seq, back) = Telemetry::decode(&t.encode(65_535)).expect("decodes");
+    assert_eq!(seq, 65_535);
+    assert_eq!((back.t_us, back.torque_est, back.fault), (t.t_us, t.torque_est, t.fault));
+    assert!(back.torque_true.is_nan());
+    assert_eq!(lost_between(65_535, 2), 2);
+    assert_eq!(lost_between(4, 5), 0);
+}
+
+#[test]
+fn the_device_refuses_a_commit_while_enabled_and_acks_telemetry() {
+    use super::device::{Action, Device};
+    let mut d = Device::default();
+    assert_eq!(d.handle(&[0x02, 1]), (Action::Enable(true), Some(Response::Ack(0x02))));
+    assert_eq!(d.handle(&[0x12, 0, 0, 0, 0]), (Action::None, Some(Response::Nack(0x12, Nack::Busy))));
+    assert_eq!(d.handle(&[0x05, 2, 0]), (Action::None, Some(Response::Ack(0x05))));
+    assert_eq!(
+        [d.telemetry_due(), d.telemetry_due(), d.telemetry_due(), d.telemetry_due()],
+        [false, true, false, true]
+    );
+    assert_eq!(d.handle(&[0x7f]), (Action::None, Some(Response::Nack(0x7f, Nack::Unknown))));
 }

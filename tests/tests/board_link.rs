@@ -1,0 +1,301 @@
+//! Issue 17 acceptance: `hil-sim virtual-board` (the firmware's application on the host)
+//! driven through `hil-sim board --port tcp:…` as a user drives a board: a set fitted by
+//! `fit --save` on a simulated recording is loaded (page CRC as `export` prints it), the
+//! bridge enabled, 3 s recorded while a multi-sine torque profile plays, and the recording
+//! fitted as it is. The recorded torque estimate is then recomputed sample by sample with
+//! the bench `hil-sim loop` runs (`closed_loop::rig` with a `ControlStep` built from the
+//! same page) from the board's journal of what it applied when: every recorded value must
+//! be the same f32. A second board with `--fault hall_open@1.0` must latch the fault within
+//! 2 ms of simulated time and report it in `board status`.
+//!
+//! Runs the `hil-sim` binary (built by this test with `cargo build -p hil-sim` in the test's
+//! own profile if needed); the virtual board runs in simulated real time (~10 s in all).
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+
+use hil_sim::closed_loop::rig::{Command as RigCommand, Rig, Stepped};
+use hil_sim::io::config_page;
+use hil_sim::io::params_file::ParamsFile;
+use hil_sim::sim::plant::ClutchParams;
+use model_core::control::{ConfigImage, ControlStep, ValidatedConfig};
+use model_core::models::algebraic::Algebraic;
+use serde_json::Value;
+
+fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../target"))
+}
+
+/// The `hil-sim` binary of this test's profile, built if needed.
+fn hil_sim() -> PathBuf {
+    let release = !cfg!(debug_assertions);
+    let mut cmd = Command::new(option_env!("CARGO").unwrap_or("cargo"));
+    cmd.args(["build", "-q", "-p", "hil-sim", "--bin", "hil-sim"]);
+    if release {
+        cmd.arg("--release");
+    }
+    let st = cmd.status().expect("running cargo build -p hil-sim");
+    assert!(st.success(), "cargo build -p hil-sim failed");
+    target_dir().join(if release { "release" } else { "debug" }).join("hil-sim")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("mrc-board-link-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("scratch dir");
+    d
+}
+
+fn run(bin: &Path, dir: &Path, args: &[&str]) -> String {
+    let out = Command::new(bin).current_dir(dir).args(args).output().expect("running hil-sim");
+    assert!(out.status.success(), "hil-sim {args:?}: {}", String::from_utf8_lossy(&out.stderr));
+    String::from_utf8(out.stdout).expect("utf-8")
+}
+
+fn json(bin: &Path, dir: &Path, args: &[&str]) -> Value {
+    let text = run(bin, dir, args);
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("hil-sim {args:?}: not JSON ({e}): {text}"))
+}
+
+/// A running virtual board, killed on drop.
+struct Board {
+    child: Child,
+    port: String,
+}
+
+impl Drop for Board {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn virtual_board(bin: &Path, dir: &Path, extra: &[&str]) -> Board {
+    let mut child = Command::new(bin)
+        .current_dir(dir)
+        .args(["virtual-board", "--listen", "tcp:127.0.0.1:0"])
+        .args(extra)
+        .stderr(Stdio::piped())
+        .stdout(Stdio::null())
+        .spawn()
+        .expect("starting the virtual board");
+    let mut lines = BufReader::new(child.stderr.take().expect("stderr")).lines();
+    let mut port = None;
+    for line in lines.by_ref() {
+        let line = line.expect("stderr line");
+        if let Some(at) = line.find("tcp:") {
+            port = Some(line[at..].trim().to_owned());
+        }
+        if line.trim() == "ready" {
+            break;
+        }
+    }
+    let port = port.expect("the virtual board printed its address before `ready`");
+    // Keep draining stderr so the board never blocks on a full pipe.
+    std::thread::spawn(move || lines.for_each(drop));
+    Board { child, port }
+}
+
+/// One row of a recording: the header's columns by name.
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).expect("recording");
+    let mut it = text.lines();
+    let head = it.next().expect("header").split(',').map(str::to_owned).collect();
+    (head, it.map(|l| l.split(',').map(str::to_owned).collect()).collect())
+}
+
+fn col(head: &[String], name: &str) -> usize {
+    head.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column `{name}` in {head:?}"))
+}
+
+/// The journal: (sample, event, value).
+fn journal(path: &Path) -> Vec<(usize, String, String)> {
+    std::fs::read_to_string(path)
+        .expect("journal")
+        .lines()
+        .map(|l| {
+            let mut w = l.split_whitespace();
+            let k = w.next().and_then(|k| k.parse().ok()).expect("sample index");
+            (k, w.next().unwrap_or("").to_owned(), w.next().unwrap_or("").to_owned())
+        })
+        .collect()
+}
+
+fn controller(img: &ConfigImage) -> ControlStep<Algebraic> {
+    let dt = img.control.get().dt;
+    ControlStep::new(img.model::<Algebraic>().expect("model"), img.rate.build(dt).expect("rate")).expect("step")
+}
+
+/// Recompute the torque estimate of every sample up to `last` from the journal, with the
+/// bench `loop` runs (rig + control step), starting from the compiled-in configuration.
+fn recompute(events: &[(usize, String, String)], page: &ConfigImage, last: usize) -> Vec<(f32, f64)> {
+    let boot = firmware::bringup::default_image().expect("default image");
+    let (boot_step, page_step) = (controller(&boot), controller(page));
+    let mut cfg: ValidatedConfig = boot.control;
+    let mut rig = Rig::new(&ClutchParams::default(), &cfg, 1, None);
+    let mut boot_ctrl = Some(Stepped(&boot_step, boot_step.state()));
+    let mut page_ctrl = None;
+    let mut cmd = RigCommand { reference: 0.0, enable: false, reset: false };
+    let mut out = Vec::with_capacity(last + 1);
+    let mut ev = events.iter().peekable();
+    for k in 0..=last {
+        cmd.reset = false;
+        while let Some((_, what, v)) = ev.next_if(|e| e.0 == k) {
+            match what.as_str() {
+                "ref" => cmd.reference = f64::from(v.parse::<f32>().expect("reference")),
+                "enable" => cmd.enable = v == "1",
+                "reset" => cmd.reset = true,
+                "release" => {
+                    cmd.enable = false;
+                    cmd.reference = 0.0;
+                }
+                "page" => {
+                    assert_eq!(v, &format!("{:#010x}", page.crc()), "the board swapped in another page");
+                    boot_ctrl = None;
+                    page_ctrl = Some(Stepped(&page_step, page_step.state()));
+                    cfg = page.control;
+                }
+                other => panic!("journal: unknown event `{other}`"),
+            }
+        }
+        let s = match (boot_ctrl.as_mut(), page_ctrl.as_mut()) {
+            (_, Some(c)) => rig.sample(c, &mut cfg, cmd),
+            (Some(c), None) => rig.sample(c, &mut cfg, cmd),
+            (None, None) => unreachable!(),
+        };
+        out.push((s.out.torque_est, s.torque_true));
+    }
+    out
+}
+
+fn multisine_profile(path: &Path) {
+    let mut text = String::from("t,reference\n");
+    for k in 0..=3000 {
+        let t = f64::from(k) * 1e-3;
+        let w = 2.0 * std::f64::consts::PI * t;
+        let r = 6.0 + 2.0 * (1.3 * w).sin() + 1.5 * (3.7 * w + 1.0).sin() + 1.0 * (7.1 * w + 2.0).sin();
+        text += &format!("{t:.3},{r:.4}\n");
+    }
+    std::fs::write(path, text).expect("profile");
+}
+
+#[test]
+fn load_enable_record_fit_and_the_same_numbers_as_loop() {
+    let bin = hil_sim();
+    let dir = scratch("record");
+    run(&bin, &dir, &["simulate", "--scenario", "sine_1hz", "--out", "sim.csv"]);
+    run(&bin, &dir, &["fit", "sim.csv", "--model", "algebraic", "--save", "fitted", "--json"]);
+    let params = dir.join("fitted/algebraic.json");
+    let exported = json(&bin, &dir, &["export", "fitted/algebraic.json", "--out", "page.bin", "--json"]);
+    multisine_profile(&dir.join("profile.csv"));
+
+    let board = virtual_board(&bin, &dir, &["--journal", "journal.txt"]);
+    let p = board.port.as_str();
+    let loaded = json(&bin, &dir, &["board", "--port", p, "--json", "load", "fitted/algebraic.json"]);
+    assert_eq!(loaded["ok"], true, "{loaded}");
+    assert_eq!(loaded["crc"], exported["crc"], "the board verified another page than `export` writes");
+    assert!(loaded["bytes"].as_u64().is_some_and(|b| b > 0), "{loaded}");
+    assert_eq!(json(&bin, &dir, &["board", "--port", p, "--json", "enable"])["ok"], true);
+    let rec = json(
+        &bin,
+        &dir,
+        &[
+            "board",
+            "--port",
+            p,
+            "--json",
+            "record",
+            "--seconds",
+            "3",
+            "--out",
+            "rec.csv",
+            "--profile",
+            "profile.csv",
+            "--enable",
+        ],
+    );
+    drop(board);
+    // 3 s at every 10th sample of 20 kHz; nothing lost on TCP.
+    let samples = rec["samples"].as_u64().expect("samples");
+    assert!((5900..=6000).contains(&samples), "{rec}");
+    assert_eq!(rec["lost_frames"], 0, "{rec}");
+
+    // The recording is fitted as it is (columns t, b, torque).
+    let fit = json(&bin, &dir, &["fit", "rec.csv", "--model", "algebraic", "--json"]);
+    let r2 = fit["results"][0]["heldout"]["r2"].as_f64().expect("r2");
+    assert!(r2 > 0.9, "fit of the recorded CSV: held-out R² {r2}");
+
+    // Same core, same numbers: the recorded estimate and true torque, recomputed.
+    let file = ParamsFile::read(&params).expect("params");
+    let control = config_page::default_control(config_page::CONTROL_HZ).expect("control");
+    let page = config_page::firmware_image(&file, &params, control).expect("page");
+    let (head, rows) = read_csv(&dir.join("rec.csv"));
+    let (ct, ce, cr, ctrue) =
+        (col(&head, "t"), col(&head, "torque_est"), col(&head, "reference"), col(&head, "torque"));
+    let dt = f64::from(page.control.get().dt);
+    let index = |r: &Vec<String>| (r[ct].parse::<f64>().expect("t") / dt).round() as usize;
+    let last = rows.iter().map(index).max().expect("rows");
+    let events = journal(&dir.join("journal.txt"));
+    assert!(events.iter().any(|e| e.1 == "page"), "the page was never swapped in");
+    let again = recompute(&events, &page, last);
+    let mut driven = 0;
+    for r in &rows {
+        let k = index(r);
+        let est: f32 = r[ce].parse().expect("torque_est");
+        let tru: f32 = r[ctrue].parse().expect("torque");
+        assert_eq!(est.to_bits(), again[k].0.to_bits(), "sample {k}: recorded {est}, recomputed {}", again[k].0);
+        assert_eq!(tru, again[k].1 as f32, "sample {k}: true torque");
+        if r[cr].parse::<f64>().expect("reference") > 1.0 && est > 1.0 {
+            driven += 1;
+        }
+    }
+    // The comparison covers a driven clutch, not a board at rest.
+    assert!(driven > rows.len() / 2, "only {driven} of {} samples with the clutch driven", rows.len());
+}
+
+#[test]
+fn an_injected_hall_fault_is_in_status_within_2_ms() {
+    let bin = hil_sim();
+    let dir = scratch("fault");
+    let board = virtual_board(&bin, &dir, &["--fault", "hall_open@1.0", "--journal", "journal.txt"]);
+    let p = board.port.as_str();
+    let rec = json(
+        &bin,
+        &dir,
+        &[
+            "board",
+            "--port",
+            p,
+            "--json",
+            "record",
+            "--seconds",
+            "1.5",
+            "--decimate",
+            "1",
+            "--out",
+            "f.csv",
+            "--enable",
+        ],
+    );
+    assert_eq!(rec["lost_frames"], 0, "{rec}");
+    let status = json(&bin, &dir, &["board", "--port", p, "--json", "status"]);
+    drop(board);
+    let enabled_at = journal(&dir.join("journal.txt"))
+        .iter()
+        .find(|e| e.1 == "enable" && e.2 == "1")
+        .map(|e| e.0 as f64 / 20_000.0)
+        .expect("enable in the journal");
+    assert!(enabled_at < 0.8, "the board was enabled at {enabled_at} s, too late for a fault at 1.0 s (slow machine?)");
+    let (head, rows) = read_csv(&dir.join("f.csv"));
+    let (ct, cf) = (col(&head, "t"), col(&head, "fault"));
+    let first = rows.iter().find(|r| r[cf] != "0").expect("the fault shows up in the recording");
+    let t: f64 = first[ct].parse().expect("t");
+    assert!((1.0..=1.002).contains(&t), "hall_open latched at {t} s (injected at 1.0 s)");
+    let code = u64::from(model_core::control::FaultCode::HallOpen.code());
+    assert_eq!(first[cf], code.to_string(), "{first:?}");
+    assert_eq!(status["fault"], code, "{status}");
+    assert_eq!(status["fault_name"], "hall_open", "{status}");
+}
