@@ -3,7 +3,7 @@
 //! [`bouc_wen_asym`](super)).
 
 use super::{BoucWenAsym, Order};
-use crate::math::{abs, atan, expm1, ln, powf, sin, tanh};
+use crate::math::{abs, atan, expm1, ln, powf, tan, tanh};
 
 /// Result of the unloading-region flow.
 pub(super) enum Fall {
@@ -120,7 +120,8 @@ impl BoucWenAsym {
                         Fall::Crossed(h - s_star)
                     } else {
                         let th = th0 - k.om2 * h;
-                        Fall::Stopped((e * sin(th) / sin(core::f32::consts::FRAC_PI_2 - th)).max(0.0))
+                        // tan in f32 (libm's sinf computes in f64: soft-float in the control interrupt).
+                        Fall::Stopped((e * tan(th)).max(0.0))
                     }
                 }
             }
