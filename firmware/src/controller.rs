@@ -80,19 +80,7 @@ pub struct Snapshot {
 /// Every `TELEMETRY_DECIMATION`-th sample is kept.
 pub const TELEMETRY_DECIMATION: u32 = 2000;
 pub static TELEMETRY: Mutex<Cell<Snapshot>> = Mutex::new(Cell::new(Snapshot {
-    out: ControlOutput {
-        duty: 0.0,
-        compare: 0,
-        pwm_enable: false,
-        b: 0.0,
-        current: 0.0,
-        torque_est: 0.0,
-        i_ref: 0.0,
-        v_cmd: 0.0,
-        mode: model_core::control::Mode::Init,
-        fault: model_core::control::FaultCode::None,
-        flags: 0,
-    },
+    out: EMPTY_OUTPUT,
     reference: 0.0,
     supply_v: 0.0,
     cycles: 0,
