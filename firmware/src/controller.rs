@@ -79,12 +79,8 @@ pub struct Snapshot {
 
 /// Every `TELEMETRY_DECIMATION`-th sample is kept.
 pub const TELEMETRY_DECIMATION: u32 = 2000;
-pub static TELEMETRY: Mutex<Cell<Snapshot>> = Mutex::new(Cell::new(Snapshot {
-    out: EMPTY_OUTPUT,
-    reference: 0.0,
-    supply_v: 0.0,
-    cycles: 0,
-}));
+pub static TELEMETRY: Mutex<Cell<Snapshot>> =
+    Mutex::new(Cell::new(Snapshot { out: EMPTY_OUTPUT, reference: 0.0, supply_v: 0.0, cycles: 0 }));
 
 /// One control sample for the serial link's telemetry stream (raw step output; the serial
 /// task numbers and encodes it).
