@@ -22,7 +22,7 @@ fn export_refuses_what_the_firmware_cannot_run() {
     let dir = scratch("export");
     let out = dir.join("page.bin");
     let out = out.to_str().unwrap();
-    // A model the firmware is not built with (its `Loop` holds algebraic, bouc_wen, lugre, tanh).
+    // A model the firmware is not built with (`firmware::runner` lists the ones it runs).
     let spencer = Path::new(env!("CARGO_MANIFEST_DIR")).join("params/spencer_dyke_1997.json");
     let (code, _, err) = hil_sim(&["export", spencer.to_str().unwrap(), "--out", out]);
     assert_ne!(code, 0);
