@@ -18,14 +18,7 @@ pub(super) fn standstill(ctx: &Ctx, name: &str, v: &[f64], s: &Scale, cfg: &Qual
         .into_iter()
         .map(|(a, b)| {
             let (lo, hi) = min_max(&v[a..=b]);
-            let what = format!(
-                "{name} does not move {}: it stays within {} to {}{} ({:.1} % of its span)",
-                ctx.when(a, b),
-                level(lo),
-                level(hi),
-                unit_suffix(name),
-                100.0 * (hi - lo) / s.span
-            );
+            let what = format!("{name} does not move {}: {}", ctx.when(a, b), stays_within(name, lo, hi, s.span));
             ctx.warning(WarningKind::Standstill, name, a, b, what)
         })
         .collect()
@@ -33,6 +26,17 @@ pub(super) fn standstill(ctx: &Ctx, name: &str, v: &[f64], s: &Scale, cfg: &Qual
 
 /// Samples belonging to some window of at least `min_s` in which `v` stays within `band`
 /// (two pointers with monotone deques: O(n)).
+/// "it stays within LO to HI UNIT (P % of its span)": the band a channel `name` keeps to.
+fn stays_within(name: &str, lo: f64, hi: f64, span: f64) -> String {
+    format!(
+        "it stays within {} to {}{} ({:.1} % of its span)",
+        level(lo),
+        level(hi),
+        unit_suffix(name),
+        100.0 * (hi - lo) / span
+    )
+}
+
 fn still(t: &[f64], v: &[f64], band: f64, min_s: f64) -> Vec<bool> {
     use std::collections::VecDeque;
     let n = v.len();
@@ -101,12 +105,9 @@ pub(super) fn reclassify(ctx: &Ctx, input: &str, x: &[f64], y: &[f64], found: &m
             _ => "between tests",
         };
         let what = format!(
-            "{input} at rest {} ({place}, a standstill): it stays within {} to {}{} ({:.1} % of its span)",
+            "{input} at rest {} ({place}, a standstill): {}",
             ctx.when(a, b),
-            level(lo),
-            level(hi),
-            unit_suffix(input),
-            100.0 * (hi - lo) / x_span
+            stays_within(input, lo, hi, x_span)
         );
         rest.push(ctx.warning(WarningKind::Standstill, input, a, b, what));
         false
