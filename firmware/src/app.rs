@@ -281,6 +281,7 @@ async fn main(spawner: Spawner) {
 
     let can = start_can(b.can, b.can_rx, b.can_tx);
     critical_section::with(|cs| RUNNING_CONFIG.borrow(cs).set(loaded.running));
+    ACTIVE_CRC.store(loaded.running.map_or(0, |(slot, _)| slot_crc(slot)), Ordering::Relaxed); // s17b
     let uart = start_uart(b.uart, b.uart_rx, b.uart_tx);
 
     let iwdg = IndependentWatchdog::new(b.iwdg, board::WATCHDOG_US);
@@ -426,6 +427,16 @@ fn reply(r: Response) -> Option<embassy_stm32::can::Frame> {
 static RUNNING_CONFIG: critical_section::Mutex<core::cell::Cell<Option<(Slot, u32)>>> =
     critical_section::Mutex::new(core::cell::Cell::new(None));
 /// A commit is being written (the other link's commit is refused meanwhile).
+// s17b (issue 17): the running page's CRC-32, shared by both links' page-CRC query: set at
+// boot from the running slot and by a commit over either link.
+static ACTIVE_CRC: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
+
+/// CRC-32 of the page in `slot` (0 when it does not decode). s17b.
+fn slot_crc(slot: Slot) -> u32 {
+    let Ok(bytes) = flash::read_slot(slot) else { return 0 };
+    ConfigImage::decode(bytes.get(..slots::IMAGE_BYTES).unwrap_or(&[])).map_or(0, |img| img.crc())
+}
+
 static COMMITTING: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
 /// The command timeout of both links together (`firmware::link`).
 static LINK: critical_section::Mutex<core::cell::Cell<LinkWatch>> =
@@ -464,6 +475,7 @@ async fn serve(device: &mut Device, data: &[u8]) -> Option<Response> {
             LINK.borrow(cs).set(l);
         });
     }
+    device.set_active_crc(ACTIVE_CRC.load(Ordering::Relaxed)); // s17b: the running page's, not this link's last commit
     match device.handle(data) {
         (Do::None, r) => r,
         (Do::Reference(t), r) => {
@@ -500,6 +512,7 @@ async fn serve(device: &mut Device, data: &[u8]) -> Option<Response> {
             };
             if let Ok((now, crc)) = result {
                 critical_section::with(|cs| RUNNING_CONFIG.borrow(cs).set(Some(now)));
+                ACTIVE_CRC.store(crc, Ordering::Relaxed); // s17b
                 device.set_active_crc(crc);
             }
             Some(device.committed(result.map(|_| ())))

@@ -48,6 +48,14 @@ pub struct Device {
 }
 
 impl Device {
+    /// A link's command state on a board that booted from a stored page: the page-CRC
+    /// query answers `active_crc` from the first frame on, not 0 until a commit over this
+    /// link. (The application keeps the running page's CRC where every link sees it and
+    /// calls [`Device::set_active_crc`] with it; a commit over another link changes it.)
+    pub fn with_active_crc(active_crc: u32) -> Self {
+        Self { active_crc, ..Self::default() }
+    }
+
     /// Handle one decoded frame's bytes: the action and, when the frame is answered at once,
     /// the reply.
     pub fn handle(&mut self, frame: &[u8]) -> (Action, Option<Response>) {

@@ -132,3 +132,13 @@ fn the_device_refuses_a_commit_while_enabled_and_acks_telemetry() {
     );
     assert_eq!(d.handle(&[0x7f]), (Action::None, Some(Response::Nack(0x7f, Nack::Unknown))));
 }
+
+#[test]
+fn the_page_crc_query_answers_the_running_page_from_boot() {
+    use super::device::{Action, Device};
+    let mut d = Device::with_active_crc(0xDEAD_BEEF);
+    assert_eq!(d.handle(&[0x13]), (Action::None, Some(Response::PageCrc(0xDEAD_BEEF))));
+    d.set_active_crc(0x1234_5678);
+    assert_eq!(d.handle(&[0x13]), (Action::None, Some(Response::PageCrc(0x1234_5678))));
+    assert_eq!(Device::default().handle(&[0x13]), (Action::None, Some(Response::PageCrc(0))));
+}
