@@ -316,3 +316,18 @@ fn the_checks_catch_what_they_look_for() {
     assert!(refs.contains(&vec!["models".to_owned(), "search".to_owned()]), "{refs:?}");
     assert!(!refs.iter().any(|r| r.first().is_some_and(|w| w == "nope")), "{refs:?}");
 }
+
+/// Issue 17: the board's `memory.x` is at the repository root (the design card), and the
+/// QEMU budget bench links with its own complete script, which includes no `memory.x`
+/// (rust-lld, run in the workspace root, would take the board's).
+#[test]
+fn memory_x_is_at_the_root_and_the_bench_has_its_own_linker_script() {
+    let r = root();
+    let mem = std::fs::read_to_string(r.join("memory.x")).expect("memory.x at the repository root");
+    assert!(mem.contains("ORIGIN = 0x08000000") && mem.contains("RAM   : ORIGIN = 0x20000000, LENGTH = 96K"), "{mem}");
+    assert!(!r.join("firmware/memory.x").exists(), "a second memory.x in firmware/");
+    let bench = std::fs::read_to_string(r.join("firmware/budget-link.x")).expect("firmware/budget-link.x");
+    assert!(!bench.lines().any(|l| l.trim_start().starts_with("INCLUDE memory.x")), "the bench includes memory.x");
+    assert!(bench.contains("FLASH : ORIGIN = 0x00000000, LENGTH = 4M"), "mps2-an386 memory in the bench script");
+    assert!(bench.contains("ENTRY(Reset)"), "a complete script (cortex-m-rt's link.x)");
+}

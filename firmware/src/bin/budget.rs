@@ -2,7 +2,7 @@
 //!
 //! Built with the shipping flags (release profile: fat LTO, opt-level 3, codegen-units 1;
 //! `thumbv7em-none-eabihf`), linked for QEMU's `mps2-an386` (Cortex-M4 with FPU, memory in
-//! `budget-memory.x`) and run there with semihosting. For every model in the registry and
+//! `budget-link.x`) and run there with semihosting. For every model in the registry and
 //! for the control step it
 //!
 //! 1. prints `step <name> <address> <calls>` (semihosting, stdout): the address of the
