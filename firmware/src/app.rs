@@ -182,7 +182,7 @@ async fn main(spawner: Spawner) {
     let b = Board::new(p);
     let cause = board::reset_cause();
     board::freeze_watchdog_in_debug();
-    info!("MR clutch controller, SYSCLK 170 MHz, control {} Hz, reset cause {}", board::CONTROL_HZ, cause);
+    info!("MR clutch controller, SYSCLK 170 MHz, PWM {} Hz, reset cause {}", board::CONTROL_HZ, cause);
     if cause.is_fault() {
         error!("RESET BY {}: the previous run stopped with the bridge switching", cause);
     }
@@ -224,7 +224,7 @@ async fn main(spawner: Spawner) {
     // One update event per PWM period at the counter underflow (the centre of the
     // high-side on-time), whatever the calls above did to the counter: stop, count from
     // 0 up, repetition counter 1, load it with UG, start ([`board::align_update`]).
-    board::align_update(1);
+    board::align_update(board::repetition_for(loaded.lp.control_hz())); // s17b: the page's control rate
     controller::safe_state();
     // Centre-aligned: a compare of ARR + 1 keeps the output active the whole period.
     let max_duty = pwm.get_max_duty() + 1;
@@ -235,6 +235,7 @@ async fn main(spawner: Spawner) {
     board::arm_break(threshold);
     board::lock_bridge_config();
     info!("PWM: {} counts for duty 1; over-current comparator at {} counts", max_duty, threshold);
+    info!("control {} Hz ({})", loaded.lp.control_hz(), loaded.lp.model_id()); // s17b
 
     // ADC1 injected sequence started by TIM1 TRGO2 (rising edge of the update pulse),
     // end-of-sequence interrupt. The supply's divider (10 kΩ / 1 kΩ ≈ 909 Ω source) gets
@@ -251,6 +252,7 @@ async fn main(spawner: Spawner) {
         DAMAGED.store(true, Ordering::Relaxed);
         controller::STALLED.store(true, Ordering::Relaxed);
     }
+    controller::CONTROL_HZ_NOW.store(loaded.lp.control_hz(), Ordering::Relaxed); // s17b
     critical_section::with(|cs| {
         controller::CONTROL.borrow_ref_mut(cs).replace(Control {
             lp: loaded.lp,
@@ -258,7 +260,7 @@ async fn main(spawner: Spawner) {
             _pwm: pwm,
             adc,
             max_duty,
-            period_cycles: board::CORE_HZ / board::CONTROL_HZ,
+            period_cycles: board::CORE_HZ / controller::CONTROL_HZ_NOW.load(Ordering::Relaxed), // s17b
             overrun: false,
             bridge: firmware::bridge::Bridge::Off,
         });
@@ -585,7 +587,8 @@ async fn serial(uart: BufferedUart<'static>) {
         controller::STREAM_DECIMATION.store(d, Ordering::Relaxed);
         while let Some(s) = critical_section::with(|cs| controller::STREAM.borrow_ref_mut(cs).pop()) {
             let t = Telemetry {
-                t_us: s.n.wrapping_mul(1_000_000 / board::CONTROL_HZ),
+                // s17b: sample index × the running rate's period (since the last rate change).
+                t_us: s.n.wrapping_mul(1_000_000 / controller::CONTROL_HZ_NOW.load(Ordering::Relaxed).max(1)),
                 b: s.out.b,
                 current: s.out.current,
                 torque_est: s.out.torque_est,

@@ -207,6 +207,22 @@ pub fn moe_on() {
     pac::TIM1.bdtr().modify(|w| w.set_moe(true));
 }
 
+/// TIM1's repetition count for one update event (ADC trigger, control interrupt) per
+/// control period at `control_hz` (a [`firmware::bringup::CONTROL_RATES`] rate; the
+/// fastest otherwise): centre-aligned, two counter turns per PWM period, so `2 n − 1` for
+/// one event every `n` PWM periods, always at the underflow.
+pub fn repetition_for(control_hz: u32) -> u8 {
+    let n = firmware::bringup::pwm_periods_per_step(control_hz).unwrap_or(1);
+    u8::try_from(2 * n - 1).unwrap_or(1)
+}
+
+/// Set TIM1's repetition count (a new control rate): RCR is preloaded, so the count in
+/// progress ends as it was and the new one starts at the next update event (still at an
+/// underflow: both counts are odd).
+pub fn set_repetition(rep: u8) {
+    pac::TIM1.rcr().write(|w| w.set_rep(u16::from(rep)));
+}
+
 /// Make TIM1's update event (TRGO2, the ADC trigger) come once per period at the counter
 /// underflow, independent of what the HAL's calls did: counter stopped, at 0, counting up,
 /// repetition counter `rep` loaded by a UG event (with URS set so UG itself raises no

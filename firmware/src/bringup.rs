@@ -5,8 +5,18 @@ use model_core::control::{ConfigImage, ControlConfig, LoopMode, PageError, RateS
 use model_core::models::algebraic;
 use model_core::Model;
 
-/// Control (and PWM) frequency, Hz: TIM1 centre-aligned, one ADC trigger per period.
+/// PWM frequency and fastest control rate, Hz: TIM1 centre-aligned, at most one ADC
+/// trigger per period.
 pub const CONTROL_HZ: u32 = 20_000;
+/// The control rates a page can run at, Hz (issue 17): the ADC trigger (TIM1's update
+/// event) every 1, 2, 4, 10 or 20 PWM periods (the repetition counter), the PWM staying at
+/// [`CONTROL_HZ`]. Each model's rate is chosen from these (`firmware::runner`).
+pub const CONTROL_RATES: [u32; 5] = [20_000, 10_000, 5_000, 2_000, 1_000];
+
+/// PWM periods per control period at `control_hz` (`None` off the menu).
+pub fn pwm_periods_per_step(control_hz: u32) -> Option<u32> {
+    CONTROL_RATES.contains(&control_hz).then(|| CONTROL_HZ / control_hz)
+}
 /// Core and timer clock, Hz.
 pub const CORE_HZ: u32 = 170_000_000;
 /// TIM1 counts for duty 1: centre-aligned, so half a period of core clocks (ARR + 1: a
@@ -31,24 +41,32 @@ pub enum BoardMismatch {
     /// `pwm_counts` is not the timer's count for duty 1: `duty_max` would be applied on
     /// the wrong scale (larger: saturating at 100 %; smaller: never reaching duty_max).
     PwmCounts,
-    /// `dt` is not this board's control period.
+    /// `dt` is not one of this board's control periods ([`CONTROL_RATES`]).
     SamplePeriod,
     /// The over-current trip is beyond what the comparator's DAC can express.
     OverCurrentRange,
 }
 
 /// Check a validated configuration against the board: the timer's counts for duty 1,
-/// the control period, the comparator threshold.
+/// the control period (one of [`CONTROL_RATES`]; whether it is the model's is
+/// `firmware::runner`'s check), the comparator threshold.
 pub fn check_board(cfg: &ValidatedConfig, timer_counts: u32) -> Result<u16, BoardMismatch> {
     let c = cfg.get();
     if c.pwm_counts != timer_counts as f32 {
         return Err(BoardMismatch::PwmCounts);
     }
-    let dt = 1.0 / CONTROL_HZ as f32;
-    if (c.dt - dt).abs() > 1e-6 * dt {
+    if rate_of_dt(c.dt).is_none() {
         return Err(BoardMismatch::SamplePeriod);
     }
     over_current_counts(c).ok_or(BoardMismatch::OverCurrentRange)
+}
+
+/// The menu rate ([`CONTROL_RATES`]) whose period is `dt` (within 1 ppm), if any.
+pub fn rate_of_dt(dt: f32) -> Option<u32> {
+    CONTROL_RATES.iter().copied().find(|&hz| {
+        let p = 1.0 / hz as f32;
+        (dt - p).abs() <= 1e-6 * p
+    })
 }
 
 /// The comparator threshold (DAC counts, same reference as the ADC) for the configured
@@ -141,8 +159,13 @@ mod tests {
     }
 
     #[test]
-    fn another_control_rate_is_refused() {
-        let mut c = ControlConfig::defaults(1.0 / 10_000.0);
+    fn a_control_rate_off_the_menu_is_refused() {
+        for hz in CONTROL_RATES {
+            assert_eq!(rate_of_dt(1.0 / hz as f32), Some(hz));
+            assert_eq!(pwm_periods_per_step(hz).map(|n| n * hz), Some(CONTROL_HZ));
+        }
+        assert_eq!(pwm_periods_per_step(7_000), None);
+        let mut c = ControlConfig::defaults(1.0 / 7_000.0);
         c.pwm_counts = PWM_COUNTS as f32;
         let v = c.validate().expect("valid");
         assert_eq!(check_board(&v, PWM_COUNTS), Err(BoardMismatch::SamplePeriod));

@@ -77,8 +77,12 @@ pub struct Snapshot {
     pub cycles: u32,
 }
 
-/// Every `TELEMETRY_DECIMATION`-th sample is kept.
-pub const TELEMETRY_DECIMATION: u32 = 2000;
+/// Telemetry snapshots per second: every `control_hz / TELEMETRY_HZ`-th sample is kept
+/// (2000 at 20 kHz), the same 10 Hz at every model's control rate.
+pub const TELEMETRY_HZ: u32 = 10;
+/// The running controller's control rate, Hz (`Loop::control_hz`; set at start-up and when
+/// a page is swapped in): the serial stream's time stamps.
+pub static CONTROL_HZ_NOW: AtomicU32 = AtomicU32::new(firmware::bringup::CONTROL_HZ);
 pub static TELEMETRY: Mutex<Cell<Snapshot>> =
     Mutex::new(Cell::new(Snapshot { out: EMPTY_OUTPUT, reference: 0.0, supply_v: 0.0, cycles: 0 }));
 
@@ -222,6 +226,11 @@ fn ADC1_2() {
             if let Some((lp, cfg)) = PENDING.borrow_ref_mut(cs).take() {
                 c.lp = lp;
                 c.cfg = cfg;
+                // Its control rate from the next update event on (issue 17).
+                let hz = c.lp.control_hz();
+                c.period_cycles = board::CORE_HZ / hz;
+                board::set_repetition(board::repetition_for(hz));
+                CONTROL_HZ_NOW.store(hz, Ordering::Relaxed);
             }
         }
         let reference = f32::from_bits(REFERENCE.load(Ordering::Relaxed));
@@ -248,7 +257,7 @@ fn ADC1_2() {
         if c.overrun {
             OVERRUNS.fetch_add(1, Ordering::Relaxed);
         }
-        if n.is_multiple_of(TELEMETRY_DECIMATION) {
+        if n.is_multiple_of(c.lp.control_hz() / TELEMETRY_HZ) {
             TELEMETRY.borrow(cs).set(Snapshot { out, reference, supply_v, cycles });
         }
         let d = STREAM_DECIMATION.load(Ordering::Relaxed);

@@ -15,23 +15,55 @@ use model_core::models::{
 };
 use model_core::Model;
 
-/// Calls `$callback!` with `Variant => model type` for every model the firmware runs.
+use crate::bringup::{rate_of_dt, CONTROL_RATES, CORE_HZ};
+
+/// Calls `$callback!` with `Variant(control rate, Hz) => model type` for every model the
+/// firmware runs: the one place the rate of each model is set (issue 17). Each is the
+/// fastest rate of [`CONTROL_RATES`] at which the model's control interrupt fits
+/// ([`fits`]) by the worst cycles `hil-sim budget` measures (`control_step_<id>` plus
+/// `supervisor_slow_<id>`, figures of 2026-11-24 in the comments); `hil-sim budget --check`
+/// fails when one no longer fits at its rate.
 macro_rules! clutch_models {
     ($callback:ident) => {
         $callback! {
-            Algebraic => algebraic::Registered,
-            BoucWen => bouc_wen::Registered,
-            LuGre => lugre::Registered,
-            Tanh => tanh::Registered,
-            Dahl => dahl::Registered,
-            HammersteinWiener => hammerstein_wiener::Registered,
-            Narx => narx::Registered,
-            PrandtlIshlinskii => prandtl_ishlinskii::Registered,
-            Gpi => gpi::Registered,
-            MaxwellSlip => maxwell_slip::Registered,
-            BoucWenAsym => bouc_wen_asym::Registered,
+            Algebraic(20_000) => algebraic::Registered,            // 520 + 4867 cycles
+            BoucWen(20_000) => bouc_wen::Registered,               // 1221 + 6640
+            LuGre(20_000) => lugre::Registered,                    // 878 + 5836
+            Tanh(20_000) => tanh::Registered,                      // 611 + 5130
+            Dahl(20_000) => dahl::Registered,                      // 1358 + 5940
+            HammersteinWiener(5_000) => hammerstein_wiener::Registered, // 6738 + 17339
+            // The first running sample seeds the NARX state by a 32-step bisection of its
+            // fixed point (~33 network evaluations): 56508 + 9704.
+            Narx(1_000) => narx::Registered,
+            PrandtlIshlinskii(20_000) => prandtl_ishlinskii::Registered, // 1720 + 6624
+            Gpi(10_000) => gpi::Registered,                        // 1977 + 7224
+            MaxwellSlip(20_000) => maxwell_slip::Registered,       // 882 + 5575
+            BoucWenAsym(20_000) => bouc_wen_asym::Registered,      // 975 + 6069
         }
     };
+}
+
+/// The rate of the slow supervisor pass, Hz (the firmware's `supervisor` task asks for it;
+/// it runs in the control interrupt's tail).
+pub const SLOW_HZ: u32 = 1_000;
+/// The share of the core the control interrupt may take, percent: the worst control step
+/// at the model's rate plus the worst slow pass at [`SLOW_HZ`] (amortised).
+pub const CPU_SHARE_PERCENT: u64 = 50;
+
+/// Whether a control interrupt fits at `control_hz` on the [`CORE_HZ`] core, from the
+/// worst cycles of its step and of its slow pass:
+/// - deadline: step + slow pass (the interrupt that runs both) within one control period;
+/// - share: `step · control_hz + slow · SLOW_HZ` at most [`CPU_SHARE_PERCENT`] of the core.
+pub fn fits(step_cycles: u64, slow_cycles: u64, control_hz: u32) -> bool {
+    let (hz, core) = (u64::from(control_hz), u64::from(CORE_HZ));
+    control_hz > 0
+        && step_cycles + slow_cycles <= core / hz
+        && 100 * (step_cycles * hz + slow_cycles * u64::from(SLOW_HZ)) <= CPU_SHARE_PERCENT * core
+}
+
+/// The fastest rate of [`CONTROL_RATES`] at which those cycles [`fits`].
+pub fn fastest_fitting(step_cycles: u64, slow_cycles: u64) -> Option<u32> {
+    CONTROL_RATES.iter().copied().find(|&hz| fits(step_cycles, slow_cycles, hz))
 }
 
 fn make<M: Model>(img: &ConfigImage) -> Result<(ControlStep<M>, ControlState<M::State>), PageError> {
@@ -42,9 +74,18 @@ fn make<M: Model>(img: &ConfigImage) -> Result<(ControlStep<M>, ControlState<M::
 }
 
 macro_rules! define_loop {
-    ($($v:ident => $m:ty),* $(,)?) => {
+    ($($v:ident($hz:literal) => $m:ty),* $(,)?) => {
         /// The model ids the firmware is built with (`Model::ID`, as `export` checks them).
         pub const MODELS: [&str; [$(stringify!($v)),*].len()] = [$(<$m as Model>::ID),*];
+
+        /// The control rate (Hz) the firmware runs model `id` at (`None`: not built in).
+        /// The page's time step must be its inverse (`hil-sim export` writes it so).
+        pub fn control_hz_of(id: &str) -> Option<u32> {
+            $(if id == <$m as Model>::ID {
+                return Some($hz);
+            })*
+            None
+        }
 
         /// The running controller: the control step of one model and its state.
         #[allow(clippy::large_enum_variant)]
@@ -57,6 +98,9 @@ macro_rules! define_loop {
             /// `from_params` at the page's time step); `WrongModel` for a model not built in.
             pub fn from_image(img: &ConfigImage) -> Result<Self, PageError> {
                 let id = img.model_id();
+                if control_hz_of(id).is_some() && control_hz_of(id) != rate_of_dt(img.control.get().dt) {
+                    return Err(PageError::Malformed("dt is not the model's control period"));
+                }
                 $(if id == <$m as Model>::ID {
                     return make::<$m>(img).map(|(s, st)| Self::$v(s, st));
                 })*
@@ -67,6 +111,15 @@ macro_rules! define_loop {
             pub fn model_id(&self) -> &'static str {
                 match self {
                     $(Self::$v(..) => <$m as Model>::ID,)*
+                }
+            }
+
+            /// The control rate this controller runs at, Hz ([`control_hz_of`] its model):
+            /// the control interrupt's rate (TIM1's repetition counter) and the inverse of
+            /// the page's time step.
+            pub fn control_hz(&self) -> u32 {
+                match self {
+                    $(Self::$v(..) => $hz,)*
                 }
             }
 
@@ -92,6 +145,37 @@ clutch_models!(define_loop);
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_model_has_a_menu_rate_and_the_share_rule_picks_it() {
+        for id in MODELS {
+            let hz = control_hz_of(id).expect("a rate");
+            assert!(CONTROL_RATES.contains(&hz), "{id}: {hz} Hz off the menu");
+        }
+        assert_eq!(control_hz_of("spencer"), None);
+        // The figures in `clutch_models!`'s comments give its rates.
+        assert_eq!(fastest_fitting(520, 4867), control_hz_of("algebraic"));
+        assert_eq!(fastest_fitting(1720, 6624), control_hz_of("prandtl_ishlinskii"));
+        assert_eq!(fastest_fitting(1977, 7224), control_hz_of("gpi"));
+        assert_eq!(fastest_fitting(6738, 17339), control_hz_of("hammerstein_wiener"));
+        assert_eq!(fastest_fitting(56508, 9704), control_hz_of("narx"));
+        // Deadline: step + slow pass beyond one 20 kHz period (8500 cycles).
+        assert!(fits(1000, 7500, 20_000) && !fits(1000, 7501, 20_000));
+        // Share: 56508 cycles at 2 kHz are 66 % of the core with the slow pass.
+        assert!(!fits(56508, 9704, 2_000) && fits(56508, 9704, 1_000));
+        assert_eq!(fastest_fitting(200_000, 0), None);
+    }
+
+    #[test]
+    fn a_page_at_another_rate_than_its_models_is_refused() {
+        let img = crate::bringup::default_image().expect("image");
+        assert_eq!(Loop::from_image(&img).map(|l| l.control_hz()).ok(), Some(20_000));
+        let mut c = *img.control.get();
+        c.dt = 1.0 / 10_000.0;
+        let control = c.validate().expect("valid");
+        let other = ConfigImage::new(img.model_id(), img.params(), img.rate, control).expect("page");
+        assert!(matches!(Loop::from_image(&other), Err(PageError::Malformed(_))));
+    }
 
     #[test]
     fn every_listed_model_is_registered_and_the_default_page_runs() {
