@@ -234,6 +234,60 @@ impl<const N: usize> Preisach<N> {
         x_max: f32,
         dt: f32,
     ) -> Result<Self, ParamError> {
+        let mut m = Self::ZEROED;
+        m.rebuild(density, sigma_hm, mu_hm, sigma_hc, mu_hc, y0, scale, x_min, x_max, dt)?;
+        Ok(m)
+    }
+
+    /// A placeholder with every field zero (not a validated model): storage for
+    /// [`Preisach::rebuild`] / [`Preisach::rebuild_from_params`] to build into, e.g. a
+    /// `static` (all zero bytes, so it costs no flash).
+    pub const ZEROED: Self = Self {
+        sigma_hm: 0.0,
+        mu_hm: 0.0,
+        sigma_hc: 0.0,
+        mu_hc: 0.0,
+        y0: 0.0,
+        scale: 0.0,
+        x_min: 0.0,
+        x_max: 0.0,
+        density: Density::GaussGauss,
+        thresholds: [0.0; N],
+        cum: [[0.0; N]; N],
+        dt: 0.0,
+    };
+
+    /// [`Model::from_params`] built in place: `self` becomes exactly what
+    /// `from_params(v, dt)` returns, without a copy of the `N × N` weight table on the stack
+    /// (the firmware builds the registered 50 × 50 model, 10 KB, into a static slot).
+    /// On an error `self` is left with unspecified (finite or not) values: build it again
+    /// before use.
+    pub fn rebuild_from_params(&mut self, v: &[f32], dt: f32) -> Result<(), ParamError> {
+        count(v, Self::N_PARAMS)?;
+        match *v {
+            [s_hm, m_hm, s_hc, m_hc, y0, scale, x_min, x_max, d] => {
+                self.rebuild(Density::from_code(d)?, s_hm, m_hm, s_hc, m_hc, y0, scale, x_min, x_max, dt)
+            }
+            _ => Err(ParamError::WrongCount { expected: Self::N_PARAMS, got: v.len() }),
+        }
+    }
+
+    /// [`Preisach::new`] in place (see [`Preisach::rebuild_from_params`]): the checks, then
+    /// the thresholds and the weights' prefix sums written into `self`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn rebuild(
+        &mut self,
+        density: Density,
+        sigma_hm: f32,
+        mu_hm: f32,
+        sigma_hc: f32,
+        mu_hc: f32,
+        y0: f32,
+        scale: f32,
+        x_min: f32,
+        x_max: f32,
+        dt: f32,
+    ) -> Result<(), ParamError> {
         if N == 0 || N > MAX_GRID {
             return Err(ParamError::Constraint { what: "Preisach grid size must be 1..=255" });
         }
@@ -253,13 +307,11 @@ impl<const N: usize> Preisach<N> {
 
         let n = N as f64;
         let u = |i: usize| (i as f64 + 0.5) / n;
-        let mut thresholds = [0.0f32; N];
-        for (i, t) in thresholds.iter_mut().enumerate() {
+        for (i, t) in self.thresholds.iter_mut().enumerate() {
             *t = (f64::from(x_min) + f64::from(span) * u(i)) as f32;
         }
         let (sm, mm, sc, mc) = (f64::from(sigma_hm), f64::from(mu_hm), f64::from(sigma_hc), f64::from(mu_hc));
-        let mut cum = [[0.0f32; N]; N];
-        for (i, row) in cum.iter_mut().enumerate() {
+        for (i, row) in self.cum.iter_mut().enumerate() {
             let mut acc = 0.0f64;
             for (j, c) in row.iter_mut().enumerate().take(i + 1) {
                 let hm = 0.5 * (u(i) + u(j));
@@ -271,6 +323,8 @@ impl<const N: usize> Preisach<N> {
                 acc += gauss(hm, mm, sm) * pc;
                 *c = (f64::from(scale) * acc) as f32;
             }
+            // Above the diagonal: no relay (zero, whatever an earlier build left there).
+            row.iter_mut().skip(i + 1).for_each(|c| *c = 0.0);
             if !row.is_finite() {
                 return Err(ParamError::Constraint {
                     what: "Preisach weights overflow (sigma too small or scale too large)",
@@ -278,11 +332,14 @@ impl<const N: usize> Preisach<N> {
             }
         }
         // The output must stay finite with every relay on.
-        let total: f32 = cum.iter().enumerate().filter_map(|(i, row)| row.get(i)).sum();
+        let total: f32 = self.cum.iter().enumerate().filter_map(|(i, row)| row.get(i)).sum();
         if !(y0 + total).is_finite() {
             return Err(ParamError::Constraint { what: "Preisach output overflows" });
         }
-        Ok(Self { sigma_hm, mu_hm, sigma_hc, mu_hc, y0, scale, x_min, x_max, density, thresholds, cum, dt })
+        (self.sigma_hm, self.mu_hm, self.sigma_hc, self.mu_hc) = (sigma_hm, mu_hm, sigma_hc, mu_hc);
+        (self.y0, self.scale, self.x_min, self.x_max) = (y0, scale, x_min, x_max);
+        (self.density, self.dt) = (density, dt);
+        Ok(())
     }
 
     /// Thresholds `αᵢ = βᵢ` in the unit of x, ascending.

@@ -160,3 +160,28 @@ fn rejects_bad_params() {
     assert!(Preisach::<10>::from_params(&huge, 1e-3).is_err());
     assert!(Preisach::<10>::from_params(&ok[..8], 1e-3).is_err());
 }
+
+#[test]
+fn built_in_place_equals_the_value_from_params() {
+    let sets: [[f32; 9]; 3] = [
+        [3.2352, 11.6040, 0.0232, 0.0001, 0.0837, 1.0, 0.0, 1.0, 1.0],
+        [1.0, 2.0, 0.1, 0.05, 0.1, 1.0, -1.0, 1.0, 0.0],
+        [0.3, 0.5, 0.2, 0.1, -0.4, 2.5, -2.0, 3.0, 0.0],
+    ];
+    // A slot that held another model (and a failed build) before each build.
+    let mut slot = Preisach::<50>::ZEROED;
+    for (k, p) in sets.iter().enumerate() {
+        let dt = 1e-4 * (k + 1) as f32;
+        assert!(slot.rebuild_from_params(&[0.0; 9], dt).is_err());
+        // Fails after part of the table is written (the Cauchy peak overflows f32).
+        assert!(slot.rebuild_from_params(&[3.2, 11.6, 1e-30, 0.0, 0.08, 1e30, 0.0, 1.0, 1.0], dt).is_err());
+        slot.rebuild_from_params(p, dt).expect("valid set");
+        let by_value = Preisach::<50>::from_params(p, dt).expect("valid set");
+        assert_eq!(slot, by_value, "set {k}");
+        let (mut a, mut b) = (State::default(), State::default());
+        for x in [-1.0, 0.3, 0.9, -0.2, 0.5, 2.0] {
+            assert_eq!(slot.step(&mut a, &kin(x)).to_bits(), by_value.step(&mut b, &kin(x)).to_bits());
+        }
+    }
+    assert!(slot.rebuild_from_params(&sets[0][..8], 1e-3).is_err());
+}
