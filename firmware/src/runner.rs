@@ -1,24 +1,28 @@
 //! The controller a configuration page describes, for every model that maps the field to
 //! torque: one variant per model, built once from a validated page (`from_image`), then
 //! stepped by the control interrupt (and by `hil-sim virtual-board` on the host) without
-//! a failure path. The damper models (command-dependent force laws in x) are not built in,
-//! and neither is `preisach`: its 50 × 50 weight table (10 KB) is built by value through
-//! `from_params` → `ControlStep::new` → the enum, several copies deep on the stack, which
-//! the commit and boot paths cannot afford next to 55 KB of static RAM (it needs an in-place
-//! constructor in model-core first).
+//! a failure path. The damper models (command-dependent force laws in x) are not built in.
+//! `preisach`'s control step (its 50 × 50 weight table, 10 KB) is built in place in a static
+//! slot the [`Loop`] owns ([`PreisachSlot`]), so neither the commit and boot paths nor the
+//! control interrupt's swap copy it. Each model runs at its own control rate
+//! ([`control_hz_of`], [`Loop::control_hz`]).
 
+use core::cell::UnsafeCell;
+use core::sync::atomic::{AtomicBool, Ordering};
 use model_core::control::ValidatedConfig;
 use model_core::control::{ConfigImage, ControlInput, ControlOutput, ControlState, ControlStep, PageError};
+
 use model_core::models::{
     algebraic, bouc_wen, bouc_wen_asym, dahl, gpi, hammerstein_wiener, lugre, maxwell_slip, narx, prandtl_ishlinskii,
-    tanh,
+    preisach, tanh,
 };
-use model_core::Model;
+use model_core::rate::RateParams;
+use model_core::{Estimator, Model};
 
 use crate::bringup::{rate_of_dt, CONTROL_RATES, CORE_HZ};
 
-/// Calls `$callback!` with `Variant(control rate, Hz) => model type` for every model the
-/// firmware runs: the one place the rate of each model is set (issue 17). Each is the
+/// Calls `$callback!` with `Variant(control rate, Hz) => model type [where its control step
+/// is kept]` for every model the firmware runs: the one place the rate of each model is set (issue 17). Each is the
 /// fastest rate of [`CONTROL_RATES`] at which the model's control interrupt fits
 /// ([`fits`]) by the worst cycles `hil-sim budget` measures (`control_step_<id>` plus
 /// `supervisor_slow_<id>`, figures of 2026-11-24 in the comments); `hil-sim budget --check`
@@ -26,19 +30,21 @@ use crate::bringup::{rate_of_dt, CONTROL_RATES, CORE_HZ};
 macro_rules! clutch_models {
     ($callback:ident) => {
         $callback! {
-            Algebraic(20_000) => algebraic::Registered,            // 520 + 4867 cycles
-            BoucWen(20_000) => bouc_wen::Registered,               // 1221 + 6640
-            LuGre(20_000) => lugre::Registered,                    // 878 + 5836
-            Tanh(20_000) => tanh::Registered,                      // 611 + 5130
-            Dahl(20_000) => dahl::Registered,                      // 1358 + 5940
-            HammersteinWiener(5_000) => hammerstein_wiener::Registered, // 6738 + 17339
+            Algebraic(20_000) => algebraic::Registered [ControlStep<algebraic::Registered>],            // 520 + 4867 cycles
+            BoucWen(20_000) => bouc_wen::Registered [ControlStep<bouc_wen::Registered>],               // 1221 + 6640
+            LuGre(20_000) => lugre::Registered [ControlStep<lugre::Registered>],                    // 878 + 5836
+            Tanh(20_000) => tanh::Registered [ControlStep<tanh::Registered>],                      // 611 + 5130
+            Dahl(20_000) => dahl::Registered [ControlStep<dahl::Registered>],                      // 1358 + 5940
+            HammersteinWiener(5_000) => hammerstein_wiener::Registered [ControlStep<hammerstein_wiener::Registered>], // 6738 + 17339
             // The first running sample seeds the NARX state by a 32-step bisection of its
             // fixed point (~33 network evaluations): 56508 + 9704.
-            Narx(1_000) => narx::Registered,
-            PrandtlIshlinskii(20_000) => prandtl_ishlinskii::Registered, // 1720 + 6624
-            Gpi(10_000) => gpi::Registered,                        // 1977 + 7224
-            MaxwellSlip(20_000) => maxwell_slip::Registered,       // 882 + 5575
-            BoucWenAsym(20_000) => bouc_wen_asym::Registered,      // 975 + 6069
+            Narx(1_000) => narx::Registered [ControlStep<narx::Registered>],
+            PrandtlIshlinskii(20_000) => prandtl_ishlinskii::Registered [ControlStep<prandtl_ishlinskii::Registered>], // 1720 + 6624
+            Gpi(10_000) => gpi::Registered [ControlStep<gpi::Registered>],                        // 1977 + 7224
+            MaxwellSlip(20_000) => maxwell_slip::Registered [ControlStep<maxwell_slip::Registered>],       // 882 + 5575
+            BoucWenAsym(20_000) => bouc_wen_asym::Registered [ControlStep<bouc_wen_asym::Registered>],      // 975 + 6069
+            // Built in place in a static slot (its 50 × 50 table, 10 KB): 1957 + 9028.
+            Preisach(10_000) => preisach::Registered [PreisachSlot],
         }
     };
 }
@@ -66,15 +72,112 @@ pub fn fastest_fitting(step_cycles: u64, slow_cycles: u64) -> Option<u32> {
     CONTROL_RATES.iter().copied().find(|&hz| fits(step_cycles, slow_cycles, hz))
 }
 
-fn make<M: Model>(img: &ConfigImage) -> Result<(ControlStep<M>, ControlState<M::State>), PageError> {
-    let rate = img.rate.build(img.control.get().dt).map_err(PageError::Invalid)?;
-    let step = ControlStep::new(img.model::<M>()?, rate).map_err(PageError::Invalid)?;
-    let state = step.state();
-    Ok((step, state))
+/// Where a controller keeps its control step: by value in the [`Loop`], or (Preisach) in a
+/// static slot the [`Loop`] owns.
+pub trait Store<M: Model>: Sized {
+    /// The control step of a page (model parameters by `from_params` at its time step).
+    fn build(img: &ConfigImage) -> Result<Self, PageError>;
+    fn get(&self) -> &ControlStep<M>;
+}
+
+impl<M: Model> Store<M> for ControlStep<M> {
+    fn build(img: &ConfigImage) -> Result<Self, PageError> {
+        let rate = img.rate.build(img.control.get().dt).map_err(PageError::Invalid)?;
+        ControlStep::new(img.model::<M>()?, rate).map_err(PageError::Invalid)
+    }
+
+    #[inline(always)]
+    fn get(&self) -> &ControlStep<M> {
+        self
+    }
+}
+
+type PreisachStep = ControlStep<preisach::Registered>;
+
+/// How many Preisach controllers can exist at once: on the board the running one and one
+/// built for a commit (or at start-up one per configuration slot); on the host (virtual
+/// boards, tests in parallel threads) more.
+#[cfg(target_os = "none")]
+pub const PREISACH_SLOTS: usize = 2;
+#[cfg(not(target_os = "none"))]
+pub const PREISACH_SLOTS: usize = 16;
+
+/// Static storage of one Preisach control step (its 50 × 50 weight table, 10 KB, is built
+/// here in place and never moved: building it by value copied it several times over the
+/// stack of the commit and boot paths, and swapping it into the control interrupt would
+/// copy it there).
+struct Slot {
+    taken: AtomicBool,
+    step: UnsafeCell<PreisachStep>,
+}
+
+// SAFETY: `step` is reached only through the one `PreisachSlot` that took the slot (a
+// compare-exchange of `taken` from false to true, released when it drops), so there is never
+// more than one owner; shared access (`get`) needs `&PreisachSlot`, building (`get_mut`)
+// `&mut PreisachSlot`, as for a value the `Loop` held itself.
+unsafe impl Sync for Slot {}
+
+/// All zero bytes (`.bss`).
+#[allow(clippy::declare_interior_mutable_const)]
+const FREE_SLOT: Slot = Slot {
+    taken: AtomicBool::new(false),
+    step: UnsafeCell::new(ControlStep {
+        est: Estimator { model: preisach::Registered::ZEROED, rate: RateParams::Backward { inv_dt: 0.0 } },
+    }),
+};
+static SLOTS: [Slot; PREISACH_SLOTS] = [FREE_SLOT; PREISACH_SLOTS];
+
+/// A Preisach control step in one of the static slots, owned by the [`Loop`] that holds it
+/// (the slot is free again when it drops).
+pub struct PreisachSlot(&'static Slot);
+
+impl PreisachSlot {
+    /// A free slot, now taken (`None`: all [`PREISACH_SLOTS`] are in use).
+    fn take() -> Option<Self> {
+        SLOTS
+            .iter()
+            .find(|s| s.taken.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).is_ok())
+            .map(Self)
+    }
+
+    fn get_mut(&mut self) -> &mut PreisachStep {
+        // SAFETY: this is the slot's only owner (see `Slot`), borrowed mutably.
+        unsafe { &mut *self.0.step.get() }
+    }
+}
+
+impl Drop for PreisachSlot {
+    fn drop(&mut self) {
+        self.0.taken.store(false, Ordering::Release);
+    }
+}
+
+impl Store<preisach::Registered> for PreisachSlot {
+    /// Built in place ([`Preisach::rebuild_from_params`](model_core::models::preisach::Preisach::rebuild_from_params)):
+    /// no copy of the table on the stack.
+    fn build(img: &ConfigImage) -> Result<Self, PageError> {
+        if img.model_id() != <preisach::Registered as Model>::ID {
+            return Err(PageError::WrongModel);
+        }
+        let dt = img.control.get().dt;
+        let rate = img.rate.build(dt).map_err(PageError::Invalid)?;
+        let mut slot = Self::take().ok_or(PageError::Malformed("every Preisach slot is in use"))?;
+        let step = slot.get_mut();
+        // `rebuild_from_params` checks the time step as `Estimator::new` does.
+        step.est.model.rebuild_from_params(img.params(), dt).map_err(PageError::Invalid)?;
+        step.est.rate = rate;
+        Ok(slot)
+    }
+
+    #[inline(always)]
+    fn get(&self) -> &PreisachStep {
+        // SAFETY: this is the slot's only owner (see `Slot`), borrowed shared.
+        unsafe { &*self.0.step.get() }
+    }
 }
 
 macro_rules! define_loop {
-    ($($v:ident($hz:literal) => $m:ty),* $(,)?) => {
+    ($($v:ident($hz:literal) => $m:ty [$store:ty]),* $(,)?) => {
         /// The model ids the firmware is built with (`Model::ID`, as `export` checks them).
         pub const MODELS: [&str; [$(stringify!($v)),*].len()] = [$(<$m as Model>::ID),*];
 
@@ -90,7 +193,7 @@ macro_rules! define_loop {
         /// The running controller: the control step of one model and its state.
         #[allow(clippy::large_enum_variant)]
         pub enum Loop {
-            $($v(ControlStep<$m>, ControlState<<$m as Model>::State>),)*
+            $($v($store, ControlState<<$m as Model>::State>),)*
         }
 
         impl Loop {
@@ -102,7 +205,7 @@ macro_rules! define_loop {
                     return Err(PageError::Malformed("dt is not the model's control period"));
                 }
                 $(if id == <$m as Model>::ID {
-                    return make::<$m>(img).map(|(s, st)| Self::$v(s, st));
+                    return <$store as Store<$m>>::build(img).map(|s| Self::$v(s, ControlState::default()));
                 })*
                 Err(PageError::WrongModel)
             }
@@ -126,7 +229,7 @@ macro_rules! define_loop {
             /// The slow supervisor pass (temperature in °C, NaN when unknown).
             pub fn slow(&mut self, cfg: &ValidatedConfig, temperature: f32) {
                 match self {
-                    $(Self::$v(s, st) => s.slow(cfg, st, temperature),)*
+                    $(Self::$v(s, st) => Store::<$m>::get(s).slow(cfg, st, temperature),)*
                 }
             }
 
@@ -134,7 +237,7 @@ macro_rules! define_loop {
             #[inline(always)]
             pub fn step(&mut self, cfg: &ValidatedConfig, x: ControlInput) -> ControlOutput {
                 match self {
-                    $(Self::$v(s, st) => s.step(cfg, st, x),)*
+                    $(Self::$v(s, st) => Store::<$m>::get(s).step(cfg, st, x),)*
                 }
             }
         }
@@ -175,6 +278,42 @@ mod tests {
         let control = c.validate().expect("valid");
         let other = ConfigImage::new(img.model_id(), img.params(), img.rate, control).expect("page");
         assert!(matches!(Loop::from_image(&other), Err(PageError::Malformed(_))));
+    }
+
+    fn preisach_page(hz: f32) -> ConfigImage {
+        let img = crate::bringup::default_image().expect("image");
+        let mut c = *img.control.get();
+        c.dt = 1.0 / hz;
+        let control = c.validate().expect("valid");
+        let p = [1.0, 2.0, 0.1, 0.05, 0.1, 1.0, -1.0, 1.0, 0.0];
+        ConfigImage::new("preisach", &p, img.rate, control).expect("page")
+    }
+
+    #[test]
+    fn preisach_runs_from_a_static_slot_as_built_by_value() {
+        let img = preisach_page(10_000.0);
+        assert!(matches!(Loop::from_image(&preisach_page(20_000.0)), Err(PageError::Malformed(_))));
+        let mut lp = Loop::from_image(&img).expect("preisach loop");
+        assert_eq!((lp.model_id(), lp.control_hz()), ("preisach", 10_000));
+        assert!(core::mem::size_of::<Loop>() < 2048, "the table is not in the Loop");
+        let by_value = <ControlStep<preisach::Registered> as Store<_>>::build(&img).expect("by value");
+        let mut st = by_value.state();
+        let cfg = img.control;
+        for k in 0..400u16 {
+            let x = ControlInput::new(2048 + k % 7, 2047 + k % 5, 24.0, 2.0);
+            if k % 10 == 0 {
+                lp.slow(&cfg, f32::NAN);
+                by_value.slow(&cfg, &mut st, f32::NAN);
+            }
+            assert_eq!(lp.step(&cfg, x), by_value.step(&cfg, &mut st, x), "sample {k}");
+        }
+        // The slots are taken and given back (one test: no other one holds slots meanwhile).
+        drop(lp);
+        let mut held: Vec<Loop> = core::iter::from_fn(|| Loop::from_image(&img).ok()).collect();
+        assert!(!held.is_empty() && held.len() <= PREISACH_SLOTS);
+        assert!(matches!(Loop::from_image(&img), Err(PageError::Malformed(_))));
+        held.pop();
+        assert!(Loop::from_image(&img).is_ok(), "a dropped Loop frees its slot");
     }
 
     #[test]

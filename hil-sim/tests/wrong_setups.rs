@@ -60,3 +60,34 @@ fn the_output_cannot_be_the_input() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 17: `export` writes the page at the rate the firmware runs the model at
+/// (`firmware::runner::control_hz_of`), says it, and refuses another rate with the reason.
+#[test]
+fn export_writes_and_prints_the_models_control_rate() {
+    let dir = scratch("export-rate");
+    let out = dir.join("page.bin");
+    let p = dir.join("gpi.json");
+    std::fs::write(&p, r#"{"model":"gpi","params":[1.0,0.1,1.0,1.0,1.0,0.5,0.2,1.0,0.5,0.2,-1.0,1.0,0.0]}"#).unwrap();
+    let want = firmware::runner::control_hz_of("gpi").expect("gpi runs on the board");
+    assert_eq!(want, 10_000, "gpi's step and slow pass overrun a 20 kHz period");
+    let (code, text, err) = hil_sim(&["export", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    assert!(text.contains("runs it at 10000 Hz"), "{text}");
+    let page = model_core::control::ConfigImage::decode(&std::fs::read(&out).unwrap()).expect("page");
+    assert_eq!(page.control.get().dt, 1.0 / 10_000.0);
+    let (code, _, err) =
+        hil_sim(&["export", p.to_str().unwrap(), "--out", out.to_str().unwrap(), "--control-hz", "20000"]);
+    assert_ne!(code, 0);
+    assert!(err.contains("runs at 10000 Hz") && one_error(&err), "{err}");
+    // Preisach runs on the board (built in place in a static slot), at its rate.
+    let p = dir.join("preisach.json");
+    std::fs::write(&p, r#"{"model":"preisach","params":[1.0,2.0,0.1,0.05,0.1,1.0,-1.0,1.0,0.0]}"#).unwrap();
+    let (code, text, err) = hil_sim(&["export", p.to_str().unwrap(), "--out", out.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&text).expect("json");
+    assert_eq!((v["model"].as_str(), v["control_hz"].as_f64()), (Some("preisach"), Some(10_000.0)), "{v}");
+    let page = model_core::control::ConfigImage::decode(&std::fs::read(&out).unwrap()).expect("page");
+    assert!(firmware::runner::Loop::from_image(&page).is_ok_and(|l| l.control_hz() == 10_000));
+    let _ = std::fs::remove_dir_all(&dir);
+}

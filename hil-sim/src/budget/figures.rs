@@ -51,6 +51,25 @@ impl StepFigures {
         v
     }
 }
+/// One model's control interrupt at the rate the firmware runs it (issue 17): its
+/// `control_step_<id>` and `supervisor_slow_<id>` worst cycles against
+/// [`firmware::runner::fits`] at [`firmware::runner::control_hz_of`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ModelRate {
+    pub model: String,
+    /// The firmware's rate for the model, Hz (`None`: the firmware does not run it).
+    pub control_hz: Option<u32>,
+    pub step_cycles: u64,
+    /// The slow pass's worst cycles (0 when not measured).
+    pub slow_cycles: u64,
+    /// `step · control_hz + slow · SLOW_HZ` in percent of the core.
+    pub cpu_percent: f64,
+    /// Step + slow pass as a percentage of one control period.
+    pub period_percent: f64,
+    /// Within the deadline and the CPU share at its rate.
+    pub fits: bool,
+}
+
 /// A whole measurement.
 #[derive(Clone, Debug, Serialize)]
 pub struct Report {
@@ -74,6 +93,7 @@ impl Report {
     /// pass beyond a period).
     pub fn over_ceiling(&self) -> Vec<String> {
         let mut v = self.named(StepFigures::over_ceiling);
+        v.extend(self.rate_violations());
         if let Some(i) = &self.interrupts {
             v.extend(i.violations());
         }
@@ -81,6 +101,63 @@ impl Report {
             let period = (CORE_HZ / CONTROL_HZ) as u64;
             if c > period {
                 v.push(format!("control interrupt with the slow pass: {c} cycles > one period ({period})"));
+            }
+        }
+        v
+    }
+
+    /// Every model's control interrupt at its firmware rate, from the `control_step_<id>`
+    /// rows (in the order measured).
+    pub fn model_rates(&self) -> Vec<ModelRate> {
+        let cycles = |n: &str| self.steps.iter().find(|s| s.name == n && !s.outside).map(|s| s.cycles_max);
+        self.steps
+            .iter()
+            .filter(|s| !s.outside)
+            .filter_map(|s| s.name.strip_prefix("control_step_").map(|id| (id, s.cycles_max)))
+            .map(|(id, step)| {
+                let slow = cycles(&format!("supervisor_slow_{id}")).unwrap_or(0);
+                let control_hz = firmware::runner::control_hz_of(id);
+                let hz = f64::from(control_hz.unwrap_or(0));
+                let slow_hz = f64::from(firmware::runner::SLOW_HZ);
+                ModelRate {
+                    model: id.to_owned(),
+                    control_hz,
+                    step_cycles: step,
+                    slow_cycles: slow,
+                    cpu_percent: 100.0 * (step as f64 * hz + slow as f64 * slow_hz) / CORE_HZ,
+                    period_percent: 100.0 * (step + slow) as f64 * hz / CORE_HZ,
+                    fits: control_hz.is_some_and(|hz| firmware::runner::fits(step, slow, hz)),
+                }
+            })
+            .collect()
+    }
+
+    /// The models the firmware runs whose control interrupt does not fit at their rate, or
+    /// that the bench did not measure.
+    pub fn rate_violations(&self) -> Vec<String> {
+        let rates = self.model_rates();
+        let mut v: Vec<String> = rates
+            .iter()
+            .filter(|r| r.control_hz.is_some() && !r.fits)
+            .map(|r| {
+                format!(
+                    "control_step_{}: {} + {} cycles (slow pass) do not fit at {} Hz ({:.0} % of the period, {:.1} % \
+                     of the CPU; share {} %)",
+                    r.model,
+                    r.step_cycles,
+                    r.slow_cycles,
+                    r.control_hz.unwrap_or(0),
+                    r.period_percent,
+                    r.cpu_percent,
+                    firmware::runner::CPU_SHARE_PERCENT
+                )
+            })
+            .collect();
+        if !rates.is_empty() {
+            for id in firmware::runner::MODELS {
+                if !rates.iter().any(|r| r.model == id) {
+                    v.push(format!("control_step_{id}: not measured (the firmware runs {id})"));
+                }
             }
         }
         v
@@ -143,6 +220,38 @@ pub fn table(r: &Report) -> String {
             100.0 * cs.cycles_min as f64 * CONTROL_HZ / CORE_HZ,
             100.0 * cs.cycles_max as f64 * CONTROL_HZ / CORE_HZ
         );
+    }
+    let rates = r.model_rates();
+    if !rates.is_empty() {
+        s += &format!(
+            "\ncontrol rate per model (firmware::runner; share: step at the rate + slow pass at {} Hz <= {} % of the CPU, \
+             step + slow pass within a period)\n{:<20} {:>8} {:>8} {:>8} {:>7} {:>7}  {}\n",
+            firmware::runner::SLOW_HZ,
+            firmware::runner::CPU_SHARE_PERCENT,
+            "model",
+            "rate Hz",
+            "step",
+            "slow",
+            "CPU %",
+            "period%",
+            "status"
+        );
+        for m in &rates {
+            s += &format!(
+                "{:<20} {:>8} {:>8} {:>8} {:>7.1} {:>7.1}  {}\n",
+                m.model,
+                m.control_hz.map_or_else(|| "-".to_owned(), |h| h.to_string()),
+                m.step_cycles,
+                m.slow_cycles,
+                m.cpu_percent,
+                m.period_percent,
+                match (m.control_hz, m.fits) {
+                    (None, _) => "not in the firmware",
+                    (Some(_), true) => "ok",
+                    (Some(_), false) => "OVER",
+                }
+            );
+        }
     }
     if r.steps.iter().any(|s| s.outside) {
         s += "\n";

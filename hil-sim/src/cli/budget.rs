@@ -35,7 +35,14 @@ impl Progress for Log {
 pub fn run(a: BudgetArgs) -> anyhow::Result<()> {
     let report = budget::run(a.elf.as_deref(), &Log)?;
     if a.json {
+        let rates = report.model_rates();
         let fig = |s: &budget::StepFigures| {
+            // A model's control step: its firmware rate and whether it fits there (issue 17).
+            let rate = s.name.strip_prefix("control_step_").and_then(|id| rates.iter().find(|r| r.model == id));
+            let within = match rate {
+                Some(r) => Some(r.fits && s.excess().is_empty()),
+                None => s.budget.map(|_| s.excess().is_empty()),
+            };
             json!({
                 "name": s.name,
                 "stack_bytes": s.stack_bytes,
@@ -48,7 +55,11 @@ pub fn run(a: BudgetArgs) -> anyhow::Result<()> {
                     "instructions": b.instructions, "stack_bytes": b.stack_bytes,
                     "ceiling_instructions": b.ceiling_instructions, "ceiling_stack_bytes": b.ceiling_stack_bytes,
                 })),
-                "within_budget": s.budget.map(|_| s.excess().is_empty()),
+                "within_budget": within,
+                "control_hz": rate.and_then(|r| r.control_hz),
+                "slow_cycles": rate.map(|r| r.slow_cycles),
+                "cpu_percent": rate.map(|r| (r.cpu_percent * 10.0).round() / 10.0),
+                "period_percent": rate.map(|r| (r.period_percent * 10.0).round() / 10.0),
             })
         };
         let steps: Vec<_> = report.steps.iter().filter(|s| !s.outside).map(fig).collect();
@@ -57,6 +68,8 @@ pub fn run(a: BudgetArgs) -> anyhow::Result<()> {
             "machine": report.machine,
             "elf": report.elf,
             "control_hz": budget::CONTROL_HZ,
+            "cpu_share_percent": firmware::runner::CPU_SHARE_PERCENT,
+            "slow_hz": firmware::runner::SLOW_HZ,
             "core_hz": budget::CORE_HZ,
             "traced_instructions": report.traced_instructions,
             "steps": steps,

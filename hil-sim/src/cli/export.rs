@@ -14,9 +14,10 @@ pub struct ExportArgs {
     /// Where to write the page (2048 bytes).
     #[arg(long)]
     pub out: PathBuf,
-    /// Control-step rate of the firmware, Hz (the model's time step is its inverse).
-    #[arg(long, default_value_t = config_page::CONTROL_HZ)]
-    pub control_hz: f32,
+    /// Control-step rate, Hz (the model's time step is its inverse). The firmware runs each
+    /// model at one rate (`firmware::runner`), used when this is not given; another is refused.
+    #[arg(long)]
+    pub control_hz: Option<f32>,
     #[arg(long)]
     pub json: bool,
 }
@@ -35,7 +36,7 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
             );
         }
     }
-    let control = config_page::default_control(a.control_hz)?;
+    let (control_hz, control) = config_page::firmware_control(&file.model, a.control_hz)?;
     let img = config_page::firmware_image(&file, &path, control)?;
     let bytes = img.encode();
     hil_sim::io::output::write(&a.out, bytes)?;
@@ -50,11 +51,11 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
         super::print_json(&json!({
             "out": a.out, "model": img.model_id(), "n_params": img.params().len(),
             "bytes": bytes.len(), "crc_covered_bytes": len, "crc": format!("{crc:#010x}"),
-            "control_hz": a.control_hz,
+            "control_hz": control_hz,
         }))
     } else {
         super::emit(&format!(
-            "{}: {} ({} parameters), {} bytes, CRC-32 {crc:#010x} over {len} bytes\n",
+            "{}: {} ({} parameters), {} bytes, CRC-32 {crc:#010x} over {len} bytes; the board runs it at {control_hz} Hz\n",
             a.out.display(),
             img.model_id(),
             img.params().len(),

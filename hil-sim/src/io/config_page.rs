@@ -28,6 +28,8 @@ pub enum PageBuildError {
     Page { path: PathBuf, source: PageError },
     #[error("default control settings at {control_hz} Hz: {source}")]
     Control { control_hz: f32, source: ParamError },
+    #[error("model `{model}` runs at {want} Hz on the firmware (`firmware::runner`), not {control_hz} Hz")]
+    WrongRate { model: String, control_hz: f32, want: u32 },
     #[error("{}: model `{model}`: the firmware runs only {} ({why})", path.display(), FIRMWARE_MODELS.join(", "))]
     NotInFirmware { path: PathBuf, model: String, why: &'static str },
     #[error("{}: {model} parameters give a torque of {value:.3e} on a representative flux sweep (±{TRIAL_B} T); \
@@ -44,8 +46,29 @@ const TRIAL_B: f32 = 1.5;
 /// Largest torque (N·m) a parameter set may give on the trial sweep.
 const TRIAL_MAX: f32 = 1e6;
 
-/// The firmware's default control rate, Hz.
+/// The firmware's fastest control rate (its PWM frequency), Hz.
 pub const CONTROL_HZ: f32 = 20_000.0;
+
+/// The control rate the firmware runs `model` at, Hz (`firmware::runner::control_hz_of`:
+/// the fastest of its rates at which the model's control interrupt fits its CPU share);
+/// `None` for a model the firmware does not run.
+pub fn firmware_control_hz(model: &str) -> Option<u32> {
+    firmware::runner::control_hz_of(model)
+}
+
+/// The default control settings at the rate the firmware runs `model` at (the page's time
+/// step is its period); `requested`, if given, must be that rate. A model the firmware does
+/// not run gets [`CONTROL_HZ`] (its page is refused by [`firmware_image`]).
+pub fn firmware_control(model: &str, requested: Option<f32>) -> Result<(f32, ValidatedConfig), PageBuildError> {
+    let hz = match (firmware_control_hz(model), requested) {
+        (Some(want), Some(hz)) if hz != want as f32 => {
+            return Err(PageBuildError::WrongRate { model: model.to_owned(), control_hz: hz, want })
+        }
+        (Some(want), _) => want as f32,
+        (None, r) => r.unwrap_or(CONTROL_HZ),
+    };
+    Ok((hz, default_control(hz)?))
+}
 
 struct Check<'a> {
     params: &'a [f32],
@@ -102,11 +125,7 @@ pub fn image(file: &ParamsFile, path: &Path, control: ValidatedConfig) -> Result
 /// its model ([`FIRMWARE_MODELS`]): what `export` writes.
 pub fn firmware_image(file: &ParamsFile, path: &Path, control: ValidatedConfig) -> Result<ConfigImage, PageBuildError> {
     if !FIRMWARE_MODELS.contains(&file.model.as_str()) {
-        let why = if file.model == model_core::models::preisach::Registered::ID {
-            "its 50 x 50 weight table, built by value, does not fit the board's stack when a page is committed or booted"
-        } else {
-            "this is a damper model, force from displacement and a command, which the clutch board cannot run"
-        };
+        let why = "this is a damper model, force from displacement and a command, which the clutch board cannot run";
         return Err(PageBuildError::NotInFirmware { path: path.to_owned(), model: file.model.clone(), why });
     }
     image(file, path, control)

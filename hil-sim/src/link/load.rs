@@ -31,7 +31,7 @@ const TRANSFERS: u32 = 3;
 /// Load `params` into the board on `link`.
 pub fn load(link: &mut Link, params: &Path, progress: &dyn Progress) -> Result<Loaded, LinkError> {
     let file = ParamsFile::read(params)?;
-    let control = config_page::default_control(config_page::CONTROL_HZ)?;
+    let (_, control) = config_page::firmware_control(&file.model, None)?;
     let img = config_page::firmware_image(&file, params, control)?;
     let page = img.encode();
     let used = usize::from(u16::from_le_bytes([page[6], page[7]])) + 4;
