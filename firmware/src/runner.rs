@@ -8,6 +8,7 @@
 //! ([`control_hz_of`], [`Loop::control_hz`]).
 
 use core::cell::UnsafeCell;
+use core::mem::MaybeUninit;
 use core::sync::atomic::{AtomicBool, Ordering};
 use model_core::control::ValidatedConfig;
 use model_core::control::{ConfigImage, ControlInput, ControlOutput, ControlState, ControlStep, PageError};
@@ -105,50 +106,73 @@ pub const PREISACH_SLOTS: usize = 16;
 /// Static storage of one Preisach control step (its 50 × 50 weight table, 10 KB, is built
 /// here in place and never moved: building it by value copied it several times over the
 /// stack of the commit and boot paths, and swapping it into the control interrupt would
-/// copy it there).
+/// copy it there). On the board the steps live in CCM SRAM (`.ccmram` in `memory.x`, not
+/// zeroed at start-up: a slot's step is written whole before its first use), the flags in
+/// the main SRAM.
 struct Slot {
     taken: AtomicBool,
-    step: UnsafeCell<PreisachStep>,
+    /// `step` holds a value (written once, at the slot's first use).
+    ready: AtomicBool,
 }
 
-// SAFETY: `step` is reached only through the one `PreisachSlot` that took the slot (a
-// compare-exchange of `taken` from false to true, released when it drops), so there is never
-// more than one owner; shared access (`get`) needs `&PreisachSlot`, building (`get_mut`)
-// `&mut PreisachSlot`, as for a value the `Loop` held itself.
-unsafe impl Sync for Slot {}
-
-/// All zero bytes (`.bss`).
 #[allow(clippy::declare_interior_mutable_const)]
-const FREE_SLOT: Slot = Slot {
-    taken: AtomicBool::new(false),
-    step: UnsafeCell::new(ControlStep {
-        est: Estimator { model: preisach::Registered::ZEROED, rate: RateParams::Backward { inv_dt: 0.0 } },
-    }),
-};
+const FREE_SLOT: Slot = Slot { taken: AtomicBool::new(false), ready: AtomicBool::new(false) };
 static SLOTS: [Slot; PREISACH_SLOTS] = [FREE_SLOT; PREISACH_SLOTS];
+
+/// The steps of [`SLOTS`], same index.
+struct Steps([UnsafeCell<MaybeUninit<PreisachStep>>; PREISACH_SLOTS]);
+
+// SAFETY: step `i` is reached only through the one `PreisachSlot` that took `SLOTS[i]` (a
+// compare-exchange of `taken` from false to true, released when it drops), so there is
+// never more than one owner; shared access (`get`) needs `&PreisachSlot`, building
+// (`get_mut`) `&mut PreisachSlot`, as for a value the `Loop` held itself.
+unsafe impl Sync for Steps {}
+
+#[allow(clippy::declare_interior_mutable_const)]
+const NO_STEP: UnsafeCell<MaybeUninit<PreisachStep>> = UnsafeCell::new(MaybeUninit::uninit());
+#[cfg_attr(target_os = "none", link_section = ".ccmram")]
+static STEPS: Steps = Steps([NO_STEP; PREISACH_SLOTS]);
+
+/// A placeholder step (all zero) a slot starts from.
+const ZERO_STEP: PreisachStep =
+    ControlStep { est: Estimator { model: preisach::Registered::ZEROED, rate: RateParams::Backward { inv_dt: 0.0 } } };
 
 /// A Preisach control step in one of the static slots, owned by the [`Loop`] that holds it
 /// (the slot is free again when it drops).
-pub struct PreisachSlot(&'static Slot);
+pub struct PreisachSlot {
+    slot: &'static Slot,
+    step: &'static UnsafeCell<MaybeUninit<PreisachStep>>,
+}
 
 impl PreisachSlot {
     /// A free slot, now taken (`None`: all [`PREISACH_SLOTS`] are in use).
     fn take() -> Option<Self> {
-        SLOTS
+        let (slot, step) = SLOTS
             .iter()
-            .find(|s| s.taken.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).is_ok())
-            .map(Self)
+            .zip(STEPS.0.iter())
+            .find(|(s, _)| s.taken.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).is_ok())?;
+        if !slot.ready.load(Ordering::Relaxed) {
+            // SAFETY: this is the slot's only owner (see `Steps`); nothing refers to the step.
+            unsafe { (*step.get()).write(ZERO_STEP) };
+            slot.ready.store(true, Ordering::Relaxed);
+        }
+        Some(Self { slot, step })
     }
 
     fn get_mut(&mut self) -> &mut PreisachStep {
-        // SAFETY: this is the slot's only owner (see `Slot`), borrowed mutably.
-        unsafe { &mut *self.0.step.get() }
+        // SAFETY: this is the slot's only owner (see `Steps`), borrowed mutably; `take`
+        // wrote the step before handing the slot out.
+        unsafe { (*self.step.get()).assume_init_mut() }
     }
 }
 
+// SAFETY: the one owner of its step (see `Steps`): moving it to another thread or to the
+// control interrupt moves that ownership, as for a value the `Loop` held itself.
+unsafe impl Send for PreisachSlot {}
+
 impl Drop for PreisachSlot {
     fn drop(&mut self) {
-        self.0.taken.store(false, Ordering::Release);
+        self.slot.taken.store(false, Ordering::Release);
     }
 }
 
@@ -171,8 +195,9 @@ impl Store<preisach::Registered> for PreisachSlot {
 
     #[inline(always)]
     fn get(&self) -> &PreisachStep {
-        // SAFETY: this is the slot's only owner (see `Slot`), borrowed shared.
-        unsafe { &*self.0.step.get() }
+        // SAFETY: this is the slot's only owner (see `Steps`), borrowed shared; `take` wrote
+        // the step before handing the slot out.
+        unsafe { (*self.step.get()).assume_init_ref() }
     }
 }
 

@@ -175,8 +175,8 @@ fn built_in_place_equals_the_value_from_params() {
         assert!(slot.rebuild_from_params(&[0.0; 9], dt).is_err());
         // Fails after part of the table is written (the Cauchy peak overflows f32).
         assert!(slot.rebuild_from_params(&[3.2, 11.6, 1e-30, 0.0, 0.08, 1e30, 0.0, 1.0, 1.0], dt).is_err());
-        slot.rebuild_from_params(p, dt).expect("valid set");
-        let by_value = Preisach::<50>::from_params(p, dt).expect("valid set");
+        slot.rebuild_from_params(p, dt).unwrap();
+        let by_value = Preisach::<50>::from_params(p, dt).unwrap();
         assert_eq!(slot, by_value, "set {k}");
         let (mut a, mut b) = (State::default(), State::default());
         for x in [-1.0, 0.3, 0.9, -0.2, 0.5, 2.0] {
