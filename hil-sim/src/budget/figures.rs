@@ -302,3 +302,50 @@ fn masked(where_: &str, m: &Masked) -> String {
         if m.calls.is_empty() { String::new() } else { format!("; calls {}", m.calls.join(", ")) }
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(name: &str, cycles_max: u64) -> StepFigures {
+        StepFigures { name: name.to_owned(), cycles_max, ..StepFigures::default() }
+    }
+
+    fn report(step: impl Fn(&str) -> Option<(u64, u64)>) -> Report {
+        let mut steps = Vec::new();
+        for id in firmware::runner::MODELS {
+            if let Some((c, s)) = step(id) {
+                steps.push(row(&format!("control_step_{id}"), c));
+                steps.push(row(&format!("supervisor_slow_{id}"), s));
+            }
+        }
+        Report { elf: PathBuf::new(), machine: "test", steps, traced_instructions: 0, interrupts: None }
+    }
+
+    #[test]
+    fn every_firmware_model_needs_a_row_that_fits_at_its_rate() {
+        // The figures of 2026-11-24 fit at the runner's rates.
+        let measured = |id: &str| match id {
+            "gpi" => Some((1977, 7224)),
+            "preisach" => Some((1957, 9028)),
+            "hammerstein_wiener" => Some((6738, 17339)),
+            "narx" => Some((56508, 9704)),
+            _ => Some((1720, 6624)),
+        };
+        let r = report(measured);
+        assert_eq!(r.model_rates().len(), firmware::runner::MODELS.len());
+        assert!(r.model_rates().iter().all(|m| m.fits && m.control_hz.is_some()));
+        assert!(r.rate_violations().is_empty(), "{:?}", r.rate_violations());
+        // A step that grew past its share, and a model the bench no longer measures.
+        let r = report(|id| match id {
+            "preisach" => None,
+            "narx" => Some((90_000, 9704)),
+            _ => measured(id),
+        });
+        let v = r.rate_violations();
+        assert_eq!(v.len(), 2, "{v:?}");
+        assert!(v.iter().any(|e| e.starts_with("control_step_narx:") && e.contains("1000 Hz")), "{v:?}");
+        assert!(v.iter().any(|e| e.contains("control_step_preisach: not measured")), "{v:?}");
+        assert_eq!(r.over_ceiling(), v);
+    }
+}
