@@ -13,6 +13,7 @@
 //! - [`runner`]: the controller of a page, for every model that maps the field to torque.
 #![cfg_attr(not(test), no_std)]
 
+pub mod application;
 pub mod bridge;
 pub mod bringup;
 pub mod can_timing;
