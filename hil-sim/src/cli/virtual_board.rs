@@ -27,7 +27,8 @@ pub struct VirtualBoardArgs {
     pub journal: Option<PathBuf>,
 }
 
-fn parse_fault(s: &str) -> anyhow::Result<Schedule> {
+/// `--fault NAME@SECONDS` (also `loop --replay`).
+pub(super) fn parse_fault(s: &str) -> anyhow::Result<Schedule> {
     let names = || Injection::ALL.iter().map(|i| i.name()).collect::<Vec<_>>().join(", ");
     let Some((name, at)) = s.split_once('@') else { bail!("--fault `{s}`: expected NAME@SECONDS (NAME: {})", names()) };
     let Some(injection) = Injection::ALL.into_iter().find(|i| i.name() == name) else {
