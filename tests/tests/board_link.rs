@@ -58,6 +58,8 @@ fn json(bin: &Path, dir: &Path, args: &[&str]) -> Value {
 struct Board {
     child: Child,
     port: String,
+    /// Its stderr after `ready`, line by line.
+    log: std::sync::mpsc::Receiver<String>,
 }
 
 impl Drop for Board {
@@ -89,8 +91,13 @@ fn virtual_board(bin: &Path, dir: &Path, extra: &[&str]) -> Board {
     }
     let port = port.expect("the virtual board printed its address before `ready`");
     // Keep draining stderr so the board never blocks on a full pipe.
-    std::thread::spawn(move || lines.for_each(drop));
-    Board { child, port }
+    let (tx, log) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for l in lines.map_while(Result::ok) {
+            let _ = tx.send(l);
+        }
+    });
+    Board { child, port, log }
 }
 
 /// One row of a recording: the header's columns by name.
@@ -257,4 +264,30 @@ fn an_injected_hall_fault_is_in_status_within_2_ms() {
     assert_eq!(first[cf], code.to_string(), "{first:?}");
     assert_eq!(status["fault"], code, "{status}");
     assert_eq!(status["fault_name"], "hall_open", "{status}");
+}
+
+#[test]
+fn a_stalled_task_starves_the_watchdog_and_the_board_resets_and_answers_again() {
+    let bin = hil_sim();
+    let dir = scratch("stall");
+    let board = virtual_board(&bin, &dir, &["--stall-tasks", "0.5"]);
+    let wait = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    let line = loop {
+        let left = wait.saturating_duration_since(std::time::Instant::now());
+        let l = board.log.recv_timeout(left).expect("a watchdog reset on stderr within 30 s");
+        if l.contains("watchdog reset at") {
+            break l;
+        }
+    };
+    let t: f64 = line
+        .split("watchdog reset at ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no time in `{line}`"));
+    // The watchdog task pets every 10 ms; the watchdog expires 50 ms after the last pet.
+    assert!((0.54..=0.551).contains(&t), "reset at {t} s for tasks stalled at 0.5 s: {line}");
+    assert!(line.contains("IndependentWatchdog"), "{line}");
+    let status = json(&bin, &dir, &["board", "--port", &board.port, "--json", "status"]);
+    assert_eq!(status["fault"], 0, "the board answers again after the reset: {status}");
 }

@@ -36,6 +36,9 @@ pub struct ServeOptions {
     pub seed: u64,
     pub fault: Option<Schedule>,
     pub journal: Journal,
+    /// From this simulated time on, s, the tasks stop being polled (a task that never
+    /// yields): the watchdog resets the board, which then runs normally.
+    pub stall_tasks: Option<f64>,
 }
 
 #[derive(Debug, Error)]
@@ -121,16 +124,22 @@ pub fn serve(opts: ServeOptions, ready: &mut dyn FnMut(SocketAddr)) -> Result<()
     let net = Net { listener, client: RefCell::new(None), rx: RefCell::default(), tx: RefCell::default() };
     ready(net.listener.local_addr()?);
     let start = Instant::now();
+    let mut stall_us = opts.stall_tasks.map(|s| (s * 1e6).round() as u64);
     loop {
-        run_boot(&clock, &flash, &mut board, &net, booted, start)?;
-        eprintln!("virtual board: watchdog reset; starting again ({:?})", ResetCause::IndependentWatchdog);
+        run_boot(&clock, &flash, &mut board, &net, booted, start, stall_us.take())?;
+        eprintln!(
+            "virtual board: watchdog reset at {:.4} s; starting again, reset cause {:?}",
+            clock.now_us() as f64 * 1e-6,
+            ResetCause::IndependentWatchdog
+        );
         let boot = store::load(&flash, &Stderr).map_err(ServeError::Page)?;
         booted = (boot.running, boot.damaged);
         board.reboot(boot.lp, boot.cfg);
     }
 }
 
-/// One boot of the application: runs until the watchdog expires.
+/// One boot of the application: runs until the watchdog expires (tasks stalled from
+/// `stall_us` on, µs, when given).
 fn run_boot(
     clock: &SimClock,
     flash: &SimFlash<'_>,
@@ -138,6 +147,7 @@ fn run_boot(
     net: &Net,
     (running, damaged): (Option<(firmware::slots::Slot, u32)>, bool),
     start: Instant,
+    stall_us: Option<u64>,
 ) -> Result<(), ServeError> {
     let ctl = SimControl::new(running, damaged);
     let shared = Shared::new(running, damaged);
@@ -159,7 +169,9 @@ fn run_boot(
         while board.samples() < due && ran < BURST {
             clock.set(board.time_us(board.samples()));
             // The tasks never end (`-> !`); polled before every sample.
-            let _ = poll_once(tasks.as_mut());
+            if !stall_us.is_some_and(|t| clock.now_us() >= t) {
+                let _ = poll_once(tasks.as_mut());
+            }
             if expired(last_pet.get(), clock.now_us()) {
                 net.send();
                 return Ok(());
