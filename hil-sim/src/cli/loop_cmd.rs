@@ -39,6 +39,9 @@ impl From<LoopScenarioArg> for LoopScenario {
 /// `--control-hz`'s default for the scenarios, Hz.
 const DEFAULT_CONTROL_HZ: f64 = 10_000.0;
 
+/// The longest `--replay`, samples (every one is kept for the trace).
+const MAX_REPLAY_SAMPLES: f64 = 3_600_000.0;
+
 /// `--duration`'s default for the multisine run, s.
 const DEFAULT_MULTISINE_S: f64 = 20.0;
 
@@ -154,7 +157,13 @@ fn replay(a: &LoopArgs, clutch: &ClutchParams) -> anyhow::Result<()> {
     if !(duration.is_finite() && duration > 0.0) {
         anyhow::bail!("--duration {duration}: expected a positive number of seconds");
     }
-    let samples = (duration * control_hz).round() as usize;
+    let samples = (duration * control_hz).round();
+    if !(1.0..=MAX_REPLAY_SAMPLES).contains(&samples) {
+        anyhow::bail!(
+            "--duration {duration} s at {control_hz} Hz: {samples} samples; a replay runs 1 to {MAX_REPLAY_SAMPLES} (3 min at 20 kHz)"
+        );
+    }
+    let samples = samples as usize;
     let rows = replay(clutch, a.seed, fault, &events, &page, samples)
         .with_context(|| format!("--replay {}", journal.display()))?;
     hil_sim::io::output::write(trace, csv(&rows))?;
