@@ -8,13 +8,15 @@
 //! counter underflow, once per period via the repetition counter) starts ADC1's injected
 //! sequence (Hall, coil current, supply), the comparator over-current trip into TIM1's
 //! break and BDTR locked, the interrupts (deadline monitor above the control interrupt,
-//! above CAN, above the time driver; [`crate::controller`]), then four tasks: CAN commands
-//! ([`model_core::protocol`], with the command timeout of [`firmware::link`]), the
-//! supervisor's slow-pass requests, decimated defmt telemetry, and the watchdog.
+//! above CAN, above the time driver; [`crate::controller`]), then the tasks of
+//! [`firmware::application`] (CAN and serial commands with the command timeout, the
+//! supervisor's slow-pass requests, decimated defmt telemetry, the watchdog) over this
+//! board's ports ([`crate::board::ports`]): this file keeps only their embassy task
+//! wrappers and the peripheral set-up.
 
 use core::sync::atomic::Ordering;
 
-use defmt::{error, info, warn};
+use defmt::{error, info};
 use defmt_rtt as _;
 use embassy_executor::Spawner;
 use embassy_stm32::adc::{Adc, AdcConfig, Exten, SampleTime};
@@ -31,18 +33,12 @@ use embassy_stm32::timer::Channel;
 use embassy_stm32::usart::{BufferedInterruptHandler, BufferedUart};
 use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::{bind_interrupts, interrupt, Config};
-use embassy_time::{Duration, Instant, Ticker, Timer};
-use firmware::bringup::{self, BoardMismatch};
-use firmware::link::{LinkAction, LinkWatch};
-use firmware::slots::{self, Boot, Slot, SlotState};
-use model_core::control::{ConfigImage, PageError, ValidatedConfig};
-use model_core::protocol::device::{Action as Do, Device, StatusFigures};
-use model_core::protocol::frame::{encode, Deframer, MAX_ENCODED};
-use model_core::protocol::telemetry::Telemetry;
-use model_core::protocol::{mode_code, Command, Nack, Response, FRAME};
+use firmware::application::{self, store, App, ControlPort, Shared};
+use firmware::bringup;
 
-use crate::board::{self, flash, Board};
-use crate::controller::{self, Control, Loop, Snapshot};
+use crate::board::ports::{BoardClock, BoardFlash, Defmt, Fdcan, Interrupts, Iwdg};
+use crate::board::{self, Board};
+use crate::controller::{self, Control};
 use crate::safety::fatal;
 
 bind_interrupts!(struct Irqs {
@@ -76,103 +72,18 @@ fn clocks() -> Config {
     config
 }
 
-/// A page error for the log (a name: formatting the numbers in it would pull core's float
-/// formatting into flash; `hil-sim export` gives the full message on the host).
-fn page_error(e: &model_core::control::PageError) -> &'static str {
-    use model_core::control::PageError as E;
-    match e {
-        E::BadMagic => "blank or foreign page",
-        E::UnsupportedVersion(_) => "unsupported format version",
-        E::Malformed(what) => what,
-        E::CrcMismatch { .. } => "CRC mismatch",
-        E::Invalid(_) => "settings or model parameters out of range",
-        E::WrongModel => "model not built into this firmware",
-    }
-}
-
-/// Which configuration runs, for telemetry and the firmware-in-the-loop test:
-/// `seq << 2 | slot` with slot 1 = A, 2 = B; 0 = compiled-in defaults on a blank board,
-/// 3 = defaults because the slots are damaged. `#[used]`: kept (and its stores with it)
-/// for the debugger and the emulator, which read it by symbol.
+/// Which configuration runs, for telemetry and the firmware-in-the-loop test
+/// ([`firmware::application::store::source_code`]). `#[used]`: kept (and its stores with
+/// it) for the debugger and the emulator, which read it by symbol.
 #[used]
 pub static CONFIG_SOURCE: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
 
-fn source_code(running: Option<(Slot, u32)>, damaged: bool) -> u32 {
-    match running {
-        Some((Slot::A, seq)) => seq << 2 | 1,
-        Some((Slot::B, seq)) => seq << 2 | 2,
-        None if damaged => 3,
-        None => 0,
-    }
-}
+/// What the link tasks share (the running configuration is set at start-up).
+static SHARED: Shared = Shared::new(None, false, 0);
 
-/// Started with no usable configuration (the loop is held in a fault until a commit).
-static DAMAGED: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
-
-/// What one slot holds.
-fn inspect(slot: Slot) -> (SlotState, Option<(Loop, ValidatedConfig)>) {
-    let Ok(bytes) = flash::read_slot(slot) else {
-        return (SlotState::Unusable("uncorrectable ECC error"), None);
-    };
-    if slots::is_blank(&bytes) {
-        return (SlotState::Blank, None);
-    }
-    let seq = match slots::record_of(&bytes) {
-        slots::Record::Committed(seq) => seq,
-        slots::Record::Absent => 0,
-        slots::Record::Broken => return (SlotState::Unusable("commit record cut (interrupted commit)"), None),
-    };
-    let image = bytes.get(..slots::IMAGE_BYTES).unwrap_or(&[]);
-    match ConfigImage::decode(image).and_then(|img| runnable(&img)) {
-        Ok(c) => (SlotState::Valid(seq), Some(c)),
-        Err(e) => (SlotState::Unusable(page_error(&e)), None),
-    }
-}
-
-/// A decoded page as a controller, checked against the board.
-fn runnable(img: &ConfigImage) -> Result<(Loop, ValidatedConfig), PageError> {
-    bringup::check_board(&img.control, board::PWM_COUNTS).map_err(|m| match m {
-        BoardMismatch::PwmCounts => PageError::Malformed("pwm_counts is not the timer's"),
-        BoardMismatch::SamplePeriod => PageError::Malformed("dt is not the control period"),
-        BoardMismatch::OverCurrentRange => PageError::Malformed("over_current beyond the comparator"),
-    })?;
-    Loop::from_image(img).map(|lp| (lp, img.control))
-}
-
-/// The configuration that boots: the newer valid slot, or the defaults (blank board), or
-/// the defaults with the loop held in a fault until a valid page is committed.
-struct Loaded {
-    lp: Loop,
-    cfg: ValidatedConfig,
-    running: Option<(Slot, u32)>,
-    damaged: bool,
-}
-
-fn load_config() -> Loaded {
-    let (sa, ca) = inspect(Slot::A);
-    let (sb, cb) = inspect(Slot::B);
-    info!("configuration slots: A {}, B {}", sa, sb);
-    let boot = slots::choose(sa, sb);
-    let chosen = match boot {
-        Boot::Slot(Slot::A, _) => ca,
-        Boot::Slot(Slot::B, _) => cb,
-        Boot::Blank | Boot::Damaged => None,
-    };
-    if let (Boot::Slot(slot, seq), Some((lp, cfg))) = (boot, chosen) {
-        info!("configuration slot {} (commit {}) loaded", slot, seq);
-        return Loaded { lp, cfg, running: Some((slot, seq)), damaged: false };
-    }
-    let damaged = boot == Boot::Damaged;
-    if damaged {
-        error!("CONFIGURATION DAMAGED: no usable slot; compiled-in defaults, drive refused until a commit");
-    } else {
-        info!("blank configuration slots: compiled-in defaults");
-    }
-    match controller::default_image().and_then(|img| runnable(&img)) {
-        Ok((lp, cfg)) => Loaded { lp, cfg, running: None, damaged },
-        Err(_) => fatal("compiled-in configuration rejected"),
-    }
-}
+/// The application over this board's ports.
+type Board0 = App<'static, BoardClock, BoardFlash, Interrupts, Defmt>;
+const APP: Board0 = App { clock: &BoardClock, flash: &BoardFlash, ctl: &Interrupts, events: &Defmt, shared: &SHARED };
 
 #[embassy_executor::main]
 async fn main(spawner: Spawner) {
@@ -191,8 +102,9 @@ async fn main(spawner: Spawner) {
     cp.DCB.enable_trace();
     cp.DWT.enable_cycle_counter();
 
-    let loaded = load_config();
-    CONFIG_SOURCE.store(source_code(loaded.running, loaded.damaged), Ordering::Relaxed);
+    let Ok(loaded) = store::load(&BoardFlash, &Defmt) else { fatal("compiled-in configuration rejected") };
+    SHARED.booted(loaded.running, loaded.damaged, loaded.crc);
+    Interrupts.running(loaded.running, loaded.damaged);
     let _flash_owner = b.flash;
 
     // Bridge: centre-aligned PWM at CONTROL_HZ, complementary outputs with dead time,
@@ -224,7 +136,7 @@ async fn main(spawner: Spawner) {
     // One update event per PWM period at the counter underflow (the centre of the
     // high-side on-time), whatever the calls above did to the counter: stop, count from
     // 0 up, repetition counter 1, load it with UG, start ([`board::align_update`]).
-    board::align_update(board::repetition_for(loaded.lp.control_hz())); // s17b: the page's control rate
+    board::align_update(board::repetition_for(loaded.lp.control_hz()));
     controller::safe_state();
     // Centre-aligned: a compare of ARR + 1 keeps the output active the whole period.
     let max_duty = pwm.get_max_duty() + 1;
@@ -235,7 +147,7 @@ async fn main(spawner: Spawner) {
     board::arm_break(threshold);
     board::lock_bridge_config();
     info!("PWM: {} counts for duty 1; over-current comparator at {} counts", max_duty, threshold);
-    info!("control {} Hz ({})", loaded.lp.control_hz(), loaded.lp.model_id()); // s17b
+    info!("control {} Hz ({})", loaded.lp.control_hz(), loaded.lp.model_id());
 
     // ADC1 injected sequence started by TIM1 TRGO2 (rising edge of the update pulse),
     // end-of-sequence interrupt. The supply's divider (10 kΩ / 1 kΩ ≈ 909 Ω source) gets
@@ -249,10 +161,10 @@ async fn main(spawner: Spawner) {
     );
 
     if loaded.damaged {
-        DAMAGED.store(true, Ordering::Relaxed);
         controller::STALLED.store(true, Ordering::Relaxed);
     }
-    controller::CONTROL_HZ_NOW.store(loaded.lp.control_hz(), Ordering::Relaxed); // s17b
+    let control_hz = loaded.lp.control_hz();
+    controller::CONTROL_HZ_NOW.store(control_hz, Ordering::Relaxed);
     critical_section::with(|cs| {
         controller::CONTROL.borrow_ref_mut(cs).replace(Control {
             lp: loaded.lp,
@@ -260,7 +172,9 @@ async fn main(spawner: Spawner) {
             _pwm: pwm,
             adc,
             max_duty,
-            period_cycles: board::CORE_HZ / controller::CONTROL_HZ_NOW.load(Ordering::Relaxed), // s17b
+            period_cycles: board::CORE_HZ / control_hz,
+            period_us: 1_000_000 / control_hz,
+            t_us: 0,
             overrun: false,
             bridge: firmware::bridge::Bridge::Off,
         });
@@ -282,8 +196,6 @@ async fn main(spawner: Spawner) {
     }
 
     let can = start_can(b.can, b.can_rx, b.can_tx);
-    critical_section::with(|cs| RUNNING_CONFIG.borrow(cs).set(loaded.running));
-    ACTIVE_CRC.store(loaded.running.map_or(0, |(slot, _)| slot_crc(slot)), Ordering::Relaxed); // s17b
     let uart = start_uart(b.uart, b.uart_rx, b.uart_tx);
 
     let iwdg = IndependentWatchdog::new(b.iwdg, board::WATCHDOG_US);
@@ -297,7 +209,7 @@ async fn main(spawner: Spawner) {
         _ => fatal("spawning tasks"),
     }
     info!("running");
-    watchdog(iwdg).await;
+    application::watchdog::run(APP, &mut Iwdg(iwdg)).await;
 }
 
 /// LPUART1 at [`board::UART_BAUD`], 8N1, interrupt-driven with its buffers.
@@ -352,294 +264,27 @@ fn start_can(
     can.into_normal_mode()
 }
 
-/// Pet the independent watchdog only while the control interrupt keeps running: a stalled
-/// loop resets the chip, and the bridge is off from reset on.
-async fn watchdog(mut iwdg: IndependentWatchdog<'static, embassy_stm32::peripherals::IWDG>) -> ! {
-    iwdg.unleash();
-    let mut last = controller::SAMPLES.load(Ordering::Relaxed);
-    let mut ticker = Ticker::every(Duration::from_millis(10));
-    loop {
-        ticker.next().await;
-        let now = controller::SAMPLES.load(Ordering::Relaxed);
-        if now != last && !controller::STALLED.load(Ordering::Relaxed) {
-            iwdg.pet();
-        } else if now == last {
-            // Bridge off and the stall latched, so the loop reports it (the mode does not
-            // read Running with the bridge off) should the interrupt come back.
-            controller::safe_state();
-            controller::STALLED.store(true, Ordering::Relaxed);
-            error!("control interrupt stalled: bridge off, watchdog will reset");
-        } else {
-            // Stalled but sampling again (deadline monitor, damaged configuration): the
-            // loop holds the bridge off in its fault; keep the watchdog fed.
-            iwdg.pet();
-        }
-        last = now;
-    }
-}
-
-/// Requests the slow supervisor pass of the control step at `SLOW_HZ` (run by the control
-/// interrupt after a compare write; the step trips `SupervisorStalled` if this task stops).
+/// [`application::supervisor`].
 #[embassy_executor::task]
 async fn supervisor() {
-    let mut ticker = Ticker::every(Duration::from_hz(controller::SLOW_HZ));
-    loop {
-        ticker.next().await;
-        controller::request_slow_pass();
-    }
+    application::supervisor::run(APP).await
 }
 
-/// Decimated telemetry in SI units (10 Hz), overruns reported loudly.
+/// [`application::telemetry`].
 #[embassy_executor::task]
 async fn telemetry() {
-    let mut ticker = Ticker::every(Duration::from_millis(100));
-    let mut overruns = 0;
-    loop {
-        ticker.next().await;
-        let s: Snapshot = critical_section::with(|cs| controller::TELEMETRY.borrow(cs).get());
-        let o = s.out;
-        info!(
-            "mode {} fault {} | T_ref {=f32} N·m T_est {=f32} N·m | B {=f32} mT i {=f32} A i_ref {=f32} A | duty {=f32} V {=f32} V | step {} cycles",
-            mode_code(o.mode),
-            o.fault.name(),
-            s.reference,
-            o.torque_est,
-            o.b * 1e3,
-            o.current,
-            o.i_ref,
-            o.duty,
-            s.supply_v,
-            s.cycles
-        );
-        let now = controller::OVERRUNS.load(Ordering::Relaxed);
-        if now != overruns {
-            error!("CONTROL STEP OVERRUN: {} missed deadlines ({} new)", now, now.wrapping_sub(overruns));
-            overruns = now;
-        }
-    }
+    application::telemetry::run(APP).await
 }
 
-fn reply(r: Response) -> Option<embassy_stm32::can::Frame> {
-    let mut buf = [0u8; FRAME];
-    let n = r.encode(&mut buf);
-    embassy_stm32::can::Frame::new_standard(board::CAN_ID_REPLY, buf.get(..n)?).ok()
-}
-
-/// The configuration running (slot, commit sequence), shared by the link tasks.
-static RUNNING_CONFIG: critical_section::Mutex<core::cell::Cell<Option<(Slot, u32)>>> =
-    critical_section::Mutex::new(core::cell::Cell::new(None));
-/// A commit is being written (the other link's commit is refused meanwhile).
-// s17b (issue 17): the running page's CRC-32, shared by both links' page-CRC query: set at
-// boot from the running slot and by a commit over either link.
-static ACTIVE_CRC: core::sync::atomic::AtomicU32 = core::sync::atomic::AtomicU32::new(0);
-
-/// CRC-32 of the page in `slot` (0 when it does not decode). s17b.
-fn slot_crc(slot: Slot) -> u32 {
-    let Ok(bytes) = flash::read_slot(slot) else { return 0 };
-    ConfigImage::decode(bytes.get(..slots::IMAGE_BYTES).unwrap_or(&[])).map_or(0, |img| img.crc())
-}
-
-static COMMITTING: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
-/// The command timeout of both links together (`firmware::link`).
-static LINK: critical_section::Mutex<core::cell::Cell<LinkWatch>> =
-    critical_section::Mutex::new(core::cell::Cell::new(LinkWatch::new(board::COMMAND_TIMEOUT_MS, 0)));
-
-fn now_ms() -> u64 {
-    Instant::now().as_millis()
-}
-
-/// Release the drive when no link has been heard for `COMMAND_TIMEOUT_MS`.
-fn watch_link(device: &mut Device) {
-    let enabled = controller::ENABLE.load(Ordering::Relaxed);
-    let action = critical_section::with(|cs| {
-        let mut l = LINK.borrow(cs).get();
-        let a = l.poll(now_ms(), enabled);
-        LINK.borrow(cs).set(l);
-        a
-    });
-    if action == LinkAction::Release {
-        controller::ENABLE.store(false, Ordering::Relaxed);
-        controller::REFERENCE.store(0, Ordering::Relaxed);
-        warn!("no command for {} ms: drive released", board::COMMAND_TIMEOUT_MS);
-    }
-    if !controller::ENABLE.load(Ordering::Relaxed) {
-        device.released();
-    }
-}
-
-/// One frame from a link through the shared command handler
-/// (`model_core::protocol::device`): its action done, its reply returned.
-async fn serve(device: &mut Device, data: &[u8]) -> Option<Response> {
-    if Command::decode(data).is_ok() {
-        critical_section::with(|cs| {
-            let mut l = LINK.borrow(cs).get();
-            l.heard(now_ms());
-            LINK.borrow(cs).set(l);
-        });
-    }
-    device.set_active_crc(ACTIVE_CRC.load(Ordering::Relaxed)); // s17b: the running page's, not this link's last commit
-    match device.handle(data) {
-        (Do::None, r) => r,
-        (Do::Reference(t), r) => {
-            controller::REFERENCE.store(t.to_bits(), Ordering::Relaxed);
-            r
-        }
-        (Do::Enable(e), r) => {
-            controller::ENABLE.store(e, Ordering::Relaxed);
-            r
-        }
-        (Do::Reset, r) => {
-            controller::RESET.store(true, Ordering::Relaxed);
-            r
-        }
-        (Do::Status, _) => {
-            let s = critical_section::with(|cs| controller::TELEMETRY.borrow(cs).get());
-            Some(device.status(StatusFigures {
-                mode: mode_code(s.out.mode),
-                fault: s.out.fault.code(),
-                overruns: controller::OVERRUNS.load(Ordering::Relaxed),
-                torque_est: s.out.torque_est,
-            }))
-        }
-        (Do::Commit, _) => {
-            let result = match (device.take_page(), COMMITTING.swap(true, Ordering::Acquire)) {
-                (_, true) => Err(Nack::Busy),
-                (None, false) => Err(Nack::Sequence),
-                (Some(img), false) => {
-                    let running = critical_section::with(|cs| RUNNING_CONFIG.borrow(cs).get());
-                    let r = commit(device.page_bytes(), &img, running).await.map(|now| (now, img.crc()));
-                    COMMITTING.store(false, Ordering::Release);
-                    r
-                }
-            };
-            if let Ok((now, crc)) = result {
-                critical_section::with(|cs| RUNNING_CONFIG.borrow(cs).set(Some(now)));
-                ACTIVE_CRC.store(crc, Ordering::Relaxed); // s17b
-                device.set_active_crc(crc);
-            }
-            Some(device.committed(result.map(|_| ())))
-        }
-    }
-}
-
-/// CAN commands (protocol in `model_core::protocol`). The acceptance filter lets only
-/// `CAN_ID_CMD` into the FIFO. A drive enabled with no command on either link for
-/// `COMMAND_TIMEOUT_MS` is released (`firmware::link`).
+/// [`application::can`] on FDCAN1 (its filter lets only `CAN_ID_CMD` into the FIFO).
 #[embassy_executor::task]
-async fn commands(mut can: embassy_stm32::can::Can<'static>) {
-    let mut device = Device::default();
-    loop {
-        let wait = Duration::from_millis(board::COMMAND_TIMEOUT_MS / 4);
-        let got = embassy_time::with_timeout(wait, can.read()).await;
-        watch_link(&mut device);
-        let env = match got {
-            Err(_timeout) => continue,
-            Ok(Ok(env)) => env,
-            Ok(Err(e)) => {
-                warn!("CAN: {}", e);
-                Timer::after_millis(1).await;
-                continue;
-            }
-        };
-        let id = match env.frame.id() {
-            embedded_can::Id::Standard(id) => id.as_raw(),
-            embedded_can::Id::Extended(_) => continue,
-        };
-        if id != board::CAN_ID_CMD {
-            continue;
-        }
-        let answer = serve(&mut device, env.frame.data()).await;
-        if let Some(frame) = answer.and_then(reply) {
-            can.write(&frame).await;
-        }
-    }
+async fn commands(can: embassy_stm32::can::Can<'static>) {
+    application::can::run(APP, Fdcan(can)).await
 }
 
-/// The serial link on LPUART1 (the ST-LINK virtual COM port): the same commands, each
-/// frame COBS-encoded with a CRC-32 (`model_core::protocol::frame`), and the telemetry
-/// stream: the control interrupt's samples at the decimation the host asked for, numbered
-/// by sample index (a gap is a lost frame), in SI units.
+/// [`application::serial`] on LPUART1 (the ST-LINK virtual COM port).
 #[embassy_executor::task]
 async fn serial(uart: BufferedUart<'static>) {
-    use embedded_io_async::{Read, Write};
-    let (mut tx, mut rx) = uart.split();
-    let mut device = Device::default();
-    let mut deframer = Deframer::default();
-    let mut buf = [0u8; 64];
-    loop {
-        let got = embassy_time::with_timeout(Duration::from_micros(500), rx.read(&mut buf)).await;
-        watch_link(&mut device);
-        let n = match got {
-            Ok(Ok(n)) => n,
-            Ok(Err(_)) | Err(_) => 0,
-        };
-        for &byte in buf.get(..n).unwrap_or(&[]) {
-            let Some(Ok(payload)) = deframer.push(byte) else { continue };
-            if let Some(r) = serve(&mut device, payload).await {
-                let mut f = [0u8; FRAME];
-                let m = r.encode(&mut f);
-                let mut out = [0u8; MAX_ENCODED];
-                let k = encode(f.get(..m).unwrap_or(&[]), &mut out);
-                let _ = tx.write_all(out.get(..k).unwrap_or(&[])).await;
-            }
-        }
-        let d = u32::from(device.decimation());
-        controller::STREAM_DECIMATION.store(d, Ordering::Relaxed);
-        while let Some(s) = critical_section::with(|cs| controller::STREAM.borrow_ref_mut(cs).pop()) {
-            let t = Telemetry {
-                // s17b: sample index × the running rate's period (since the last rate change).
-                t_us: s.n.wrapping_mul(1_000_000 / controller::CONTROL_HZ_NOW.load(Ordering::Relaxed).max(1)),
-                b: s.out.b,
-                current: s.out.current,
-                torque_est: s.out.torque_est,
-                reference: s.reference,
-                duty: s.out.duty,
-                mode: mode_code(s.out.mode),
-                fault: s.out.fault.code(),
-                torque_true: f32::NAN,
-            };
-            let seq = (s.n / d.max(1)) as u16;
-            let mut out = [0u8; MAX_ENCODED];
-            let k = encode(&t.encode(seq), &mut out);
-            let _ = tx.write_all(out.get(..k).unwrap_or(&[])).await;
-        }
-    }
-}
-
-/// Validate the received page, write it to the slot not running (erase, image, commit
-/// record last; the waits yield, so the control interrupt and the watchdog task keep
-/// running), read it back, hand it to the control interrupt.
-async fn commit(
-    bytes: &[u8; model_core::control::page::PAGE_BYTES],
-    img: &ConfigImage,
-    running: Option<(Slot, u32)>,
-) -> Result<(Slot, u32), Nack> {
-    if controller::ENABLE.load(Ordering::Relaxed) {
-        return Err(Nack::Busy);
-    }
-    // Checked now, built again once written: a controller held across the flash waits
-    // would sit in both link tasks' futures (11 KB each with every model built in).
-    runnable(img).map(drop).map_err(|_| Nack::InvalidPage)?;
-    let (slot, seq) = slots::commit_target(running);
-    let image = slots::slot_image(bytes, seq).ok_or(Nack::InvalidPage)?;
-    flash::program_slot(slot, &image).await.map_err(|e| {
-        error!("configuration commit to slot {}: {}", slot, e);
-        Nack::Flash
-    })?;
-    match inspect(slot) {
-        (SlotState::Valid(s), _) if s == seq => {}
-        (state, _) => {
-            error!("configuration slot {} reads back as {}", slot, state);
-            return Err(Nack::Flash);
-        }
-    }
-    let built = runnable(img).map_err(|_| Nack::InvalidPage)?;
-    critical_section::with(|cs| controller::PENDING.borrow_ref_mut(cs).replace(built));
-    // A board held by a damaged configuration runs again once a good page is committed.
-    if DAMAGED.swap(false, Ordering::Relaxed) {
-        controller::RESET.store(true, Ordering::Relaxed);
-    }
-    CONFIG_SOURCE.store(source_code(Some((slot, seq)), false), Ordering::Relaxed);
-    info!("new configuration: model {}, slot {} commit {}", img.model_id(), slot, seq);
-    Ok((slot, seq))
+    let (tx, rx) = uart.split();
+    application::serial::run(APP, rx, tx).await
 }

@@ -16,17 +16,18 @@ use firmware::bringup::ResetCause;
 pub use firmware::bringup::{CONTROL_HZ, CORE_HZ, PWM_COUNTS};
 
 pub mod flash;
+pub mod ports;
 
 /// Dead time of the bridge, TIM1 DTG value (see RM0440 §28.6.20: ≤ 127 → that many
 /// 170 MHz ticks): 85 ticks = 500 ns, for gate drivers with ~200 ns propagation skew.
 pub const DEAD_TIME_DTG: u16 = 85;
 /// The Nucleo-G474RE's crystal (X3), Hz: the PLL input and FDCAN's kernel clock.
 pub const HSE_HZ: u32 = 24_000_000;
-/// CAN bit rate and identifiers: commands to `CAN_ID_CMD`, replies from `CAN_ID_REPLY`.
+/// CAN bit rate, bit/s.
 pub const CAN_BITRATE: u32 = 1_000_000;
-pub const CAN_ID_CMD: u16 = 0x120;
-pub const CAN_ID_REPLY: u16 = 0x121;
-pub use firmware::link::COMMAND_TIMEOUT_MS;
+/// Commands arrive on this identifier (the acceptance filter's), replies leave from
+/// `firmware::application::can::ID_REPLY`.
+pub use firmware::application::can::ID_CMD as CAN_ID_CMD;
 /// The serial link's baud rate (`hil-sim board --port /dev/ttyACM0` uses the same).
 pub const UART_BAUD: u32 = 921_600;
 /// Independent watchdog timeout, µs.

@@ -3,7 +3,7 @@
 //! on every sample and writes the bridge. The slow supervisor pass
 //! (`ControlStep::slow`: configuration fingerprint, time step, temperature compensation)
 //! runs in the same interrupt, after the compare write, on the first sample after the
-//! `supervisor` task asks for it ([`SLOW_HZ`], [`request_slow_pass`]): thread mode never
+//! `supervisor` task asks for it (`firmware::application::supervisor`, [`request_slow_pass`]): thread mode never
 //! masks interrupts around it, and the compare write is never delayed by it.
 //!
 //! TIM1's update interrupt, one priority level above, is the deadline monitor: at every
@@ -22,13 +22,11 @@ use embassy_stm32::peripherals::{ADC1, TIM1};
 use embassy_stm32::timer::complementary_pwm::ComplementaryPwm;
 use model_core::control::{ControlInput, ControlOutput, ValidatedConfig};
 
+use firmware::application::{Snapshot, StreamRing, StreamSample};
 use firmware::bridge::{self, Bridge};
 pub use firmware::runner::Loop;
 
 use crate::board;
-
-/// The compiled-in configuration ([`firmware::bringup::default_image`]).
-pub use firmware::bringup::default_image;
 
 /// What the interrupt owns.
 pub struct Control {
@@ -42,6 +40,10 @@ pub struct Control {
     pub max_duty: u32,
     /// Core cycles in one control period (the overrun limit).
     pub period_cycles: u32,
+    /// One control period, µs (1e6 / the page's control rate: 50 to 1000, exact).
+    pub period_us: u32,
+    /// Time of the last sample since start-up, µs (the stream's time stamps).
+    pub t_us: u32,
     /// The previous step missed its deadline.
     pub overrun: bool,
     pub bridge: Bridge,
@@ -67,93 +69,18 @@ static SLOW_DUE: AtomicBool = AtomicBool::new(false);
 /// SAMPLES at the previous period start (deadline monitor).
 static LAST_SEEN: AtomicU32 = AtomicU32::new(0);
 
-/// One decimated sample for telemetry (raw output of the step; formatting and unit
-/// scaling happen in the telemetry task).
-#[derive(Clone, Copy, Default)]
-pub struct Snapshot {
-    pub out: ControlOutput,
-    pub reference: f32,
-    pub supply_v: f32,
-    pub cycles: u32,
-}
-
 /// Telemetry snapshots per second: every `control_hz / TELEMETRY_HZ`-th sample is kept
 /// (2000 at 20 kHz), the same 10 Hz at every model's control rate.
 pub const TELEMETRY_HZ: u32 = 10;
 /// The running controller's control rate, Hz (`Loop::control_hz`; set at start-up and when
 /// a page is swapped in): the serial stream's time stamps.
 pub static CONTROL_HZ_NOW: AtomicU32 = AtomicU32::new(firmware::bringup::CONTROL_HZ);
-pub static TELEMETRY: Mutex<Cell<Snapshot>> =
-    Mutex::new(Cell::new(Snapshot { out: EMPTY_OUTPUT, reference: 0.0, supply_v: 0.0, cycles: 0 }));
-
-/// One control sample for the serial link's telemetry stream (raw step output; the serial
-/// task numbers and encodes it).
-#[derive(Clone, Copy, Default)]
-pub struct StreamSample {
-    /// Sample index since start-up.
-    pub n: u32,
-    pub out: ControlOutput,
-    pub reference: f32,
-}
-
-/// Samples waiting for the serial task; a full ring drops the newest (the host sees the
-/// gap in the sequence numbers).
-pub struct StreamRing {
-    buf: [StreamSample; STREAM_RING],
-    head: usize,
-    len: usize,
-}
-
-const STREAM_RING: usize = 16;
-
-impl StreamRing {
-    const fn new() -> Self {
-        Self { buf: [StreamSample { n: 0, out: EMPTY_OUTPUT, reference: 0.0 }; STREAM_RING], head: 0, len: 0 }
-    }
-
-    #[inline(always)]
-    fn push(&mut self, s: StreamSample) {
-        if self.len < STREAM_RING {
-            if let Some(slot) = self.buf.get_mut((self.head + self.len) % STREAM_RING) {
-                *slot = s;
-                self.len += 1;
-            }
-        }
-    }
-
-    /// The oldest sample.
-    pub fn pop(&mut self) -> Option<StreamSample> {
-        if self.len == 0 {
-            return None;
-        }
-        let s = self.buf.get(self.head).copied();
-        self.head = (self.head + 1) % STREAM_RING;
-        self.len -= 1;
-        s
-    }
-}
+pub static TELEMETRY: Mutex<Cell<Snapshot>> = Mutex::new(Cell::new(Snapshot::EMPTY));
 
 /// Every `STREAM_DECIMATION`-th sample goes to [`STREAM`] (0: none); set by the serial task.
 pub static STREAM_DECIMATION: AtomicU32 = AtomicU32::new(0);
 pub static STREAM: Mutex<RefCell<StreamRing>> = Mutex::new(RefCell::new(StreamRing::new()));
 
-const EMPTY_OUTPUT: ControlOutput = ControlOutput {
-    duty: 0.0,
-    compare: 0,
-    pwm_enable: false,
-    b: 0.0,
-    current: 0.0,
-    torque_est: 0.0,
-    i_ref: 0.0,
-    v_cmd: 0.0,
-    mode: model_core::control::Mode::Init,
-    fault: model_core::control::FaultCode::None,
-    flags: 0,
-};
-
-/// Rate of the slow supervisor pass (the step trips `SupervisorStalled` after 0.1 s
-/// without one).
-pub const SLOW_HZ: u64 = 1_000;
 /// Slow passes run (telemetry).
 pub static SLOW_PASSES: AtomicU32 = AtomicU32::new(0);
 
@@ -229,6 +156,7 @@ fn ADC1_2() {
                 // Its control rate from the next update event on (issue 17).
                 let hz = c.lp.control_hz();
                 c.period_cycles = board::CORE_HZ / hz;
+                c.period_us = 1_000_000 / hz;
                 board::set_repetition(board::repetition_for(hz));
                 CONTROL_HZ_NOW.store(hz, Ordering::Relaxed);
             }
@@ -251,6 +179,7 @@ fn ADC1_2() {
         let out = c.lp.step(&c.cfg, input);
         drive(c, &out, stalled);
         let n = SAMPLES.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
+        c.t_us = c.t_us.wrapping_add(c.period_us);
         RUNNING.store(true, Ordering::Relaxed);
         let cycles = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);
         c.overrun = cycles > c.period_cycles;
@@ -262,7 +191,7 @@ fn ADC1_2() {
         }
         let d = STREAM_DECIMATION.load(Ordering::Relaxed);
         if d != 0 && n.is_multiple_of(d) {
-            STREAM.borrow_ref_mut(cs).push(StreamSample { n, out, reference });
+            STREAM.borrow_ref_mut(cs).push(StreamSample { n, t_us: c.t_us, out, reference, torque_true: f32::NAN });
         }
         // The slow pass after the compare write (the board has no temperature sensor:
         // NaN, no compensation).

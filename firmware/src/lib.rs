@@ -3,6 +3,9 @@
 //! only decisions. The board-facing code is the `firmware` binary (`main.rs`: `app`,
 //! `board`, `controller`, `safety`), the only place that touches registers.
 //!
+//! - [`application`]: the application's tasks (command links, configuration store,
+//!   supervisor, telemetry, watchdog) over a few port traits the board (and
+//!   `hil-sim virtual-board`) implements.
 //! - [`slots`]: the A/B configuration pages (which one boots, where a commit goes).
 //! - [`link`]: the command timeout (the host disappearing disables the drive).
 //! - [`can_timing`]: FDCAN nominal bit timing and its oscillator tolerance.
@@ -13,6 +16,7 @@
 //! - [`runner`]: the controller of a page, for every model that maps the field to torque.
 #![cfg_attr(not(test), no_std)]
 
+pub mod application;
 pub mod bridge;
 pub mod bringup;
 pub mod can_timing;

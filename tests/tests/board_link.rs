@@ -2,10 +2,10 @@
 //! driven through `hil-sim board --port tcp:…` as a user drives a board: a set fitted by
 //! `fit --save` on a simulated recording is loaded (page CRC as `export` prints it), the
 //! bridge enabled, 3 s recorded while a multi-sine torque profile plays, and the recording
-//! fitted as it is. The recorded torque estimate is then recomputed sample by sample with
-//! the bench `hil-sim loop` runs (`closed_loop::rig` with a `ControlStep` built from the
-//! same page) from the board's journal of what it applied when: every recorded value must
-//! be the same f32. A second board with `--fault hall_open@1.0` must latch the fault within
+//! fitted as it is. `hil-sim loop --replay` then runs the board's journal of what it
+//! applied when through the bench `loop` runs (`closed_loop::rig` with the firmware's
+//! controller built from the same page by the same configuration store): every recorded
+//! torque estimate and true torque must be the same f32, bit for bit. A second board with `--fault hall_open@1.0` must latch the fault within
 //! 2 ms of simulated time and report it in `board status`.
 //!
 //! Runs the `hil-sim` binary (built by this test with `cargo build -p hil-sim` in the test's
@@ -15,12 +15,6 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 
-use hil_sim::closed_loop::rig::{Command as RigCommand, Rig, Stepped};
-use hil_sim::io::config_page;
-use hil_sim::io::params_file::ParamsFile;
-use hil_sim::sim::plant::ClutchParams;
-use model_core::control::{ConfigImage, ControlStep, ValidatedConfig};
-use model_core::models::algebraic::Algebraic;
 use serde_json::Value;
 
 fn target_dir() -> PathBuf {
@@ -64,6 +58,8 @@ fn json(bin: &Path, dir: &Path, args: &[&str]) -> Value {
 struct Board {
     child: Child,
     port: String,
+    /// Its stderr after `ready`, line by line.
+    log: std::sync::mpsc::Receiver<String>,
 }
 
 impl Drop for Board {
@@ -95,8 +91,13 @@ fn virtual_board(bin: &Path, dir: &Path, extra: &[&str]) -> Board {
     }
     let port = port.expect("the virtual board printed its address before `ready`");
     // Keep draining stderr so the board never blocks on a full pipe.
-    std::thread::spawn(move || lines.for_each(drop));
-    Board { child, port }
+    let (tx, log) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for l in lines.map_while(Result::ok) {
+            let _ = tx.send(l);
+        }
+    });
+    Board { child, port, log }
 }
 
 /// One row of a recording: the header's columns by name.
@@ -124,53 +125,6 @@ fn journal(path: &Path) -> Vec<(usize, String, String)> {
         .collect()
 }
 
-fn controller(img: &ConfigImage) -> ControlStep<Algebraic> {
-    let dt = img.control.get().dt;
-    ControlStep::new(img.model::<Algebraic>().expect("model"), img.rate.build(dt).expect("rate")).expect("step")
-}
-
-/// Recompute the torque estimate of every sample up to `last` from the journal, with the
-/// bench `loop` runs (rig + control step), starting from the compiled-in configuration.
-fn recompute(events: &[(usize, String, String)], page: &ConfigImage, last: usize) -> Vec<(f32, f64)> {
-    let boot = firmware::bringup::default_image().expect("default image");
-    let (boot_step, page_step) = (controller(&boot), controller(page));
-    let mut cfg: ValidatedConfig = boot.control;
-    let mut rig = Rig::new(&ClutchParams::default(), &cfg, 1, None);
-    let mut boot_ctrl = Some(Stepped(&boot_step, boot_step.state()));
-    let mut page_ctrl = None;
-    let mut cmd = RigCommand { reference: 0.0, enable: false, reset: false };
-    let mut out = Vec::with_capacity(last + 1);
-    let mut ev = events.iter().peekable();
-    for k in 0..=last {
-        cmd.reset = false;
-        while let Some((_, what, v)) = ev.next_if(|e| e.0 == k) {
-            match what.as_str() {
-                "ref" => cmd.reference = f64::from(v.parse::<f32>().expect("reference")),
-                "enable" => cmd.enable = v == "1",
-                "reset" => cmd.reset = true,
-                "release" => {
-                    cmd.enable = false;
-                    cmd.reference = 0.0;
-                }
-                "page" => {
-                    assert_eq!(v, &format!("{:#010x}", page.crc()), "the board swapped in another page");
-                    boot_ctrl = None;
-                    page_ctrl = Some(Stepped(&page_step, page_step.state()));
-                    cfg = page.control;
-                }
-                other => panic!("journal: unknown event `{other}`"),
-            }
-        }
-        let s = match (boot_ctrl.as_mut(), page_ctrl.as_mut()) {
-            (_, Some(c)) => rig.sample(c, &mut cfg, cmd),
-            (Some(c), None) => rig.sample(c, &mut cfg, cmd),
-            (None, None) => unreachable!(),
-        };
-        out.push((s.out.torque_est, s.torque_true));
-    }
-    out
-}
-
 fn multisine_profile(path: &Path) {
     let mut text = String::from("t,reference\n");
     for k in 0..=3000 {
@@ -188,7 +142,6 @@ fn load_enable_record_fit_and_the_same_numbers_as_loop() {
     let dir = scratch("record");
     run(&bin, &dir, &["simulate", "--scenario", "sine_1hz", "--out", "sim.csv"]);
     run(&bin, &dir, &["fit", "sim.csv", "--model", "algebraic", "--save", "fitted", "--json"]);
-    let params = dir.join("fitted/algebraic.json");
     let exported = json(&bin, &dir, &["export", "fitted/algebraic.json", "--out", "page.bin", "--json"]);
     multisine_profile(&dir.join("profile.csv"));
 
@@ -228,26 +181,39 @@ fn load_enable_record_fit_and_the_same_numbers_as_loop() {
     let r2 = fit["results"][0]["heldout"]["r2"].as_f64().expect("r2");
     assert!(r2 > 0.9, "fit of the recorded CSV: held-out R² {r2}");
 
-    // Same core, same numbers: the recorded estimate and true torque, recomputed.
-    let file = ParamsFile::read(&params).expect("params");
-    let control = config_page::default_control(config_page::CONTROL_HZ).expect("control");
-    let page = config_page::firmware_image(&file, &params, control).expect("page");
+    // Same core, same numbers: `loop` replays the board's journal.
     let (head, rows) = read_csv(&dir.join("rec.csv"));
     let (ct, ce, cr, ctrue) =
         (col(&head, "t"), col(&head, "torque_est"), col(&head, "reference"), col(&head, "torque"));
-    let dt = f64::from(page.control.get().dt);
-    let index = |r: &Vec<String>| (r[ct].parse::<f64>().expect("t") / dt).round() as usize;
-    let last = rows.iter().map(index).max().expect("rows");
+    let dt = 1.0 / 20_000.0;
+    // The sample index of a row by its time stamp in column `c`.
+    let index = |r: &Vec<String>, c: usize| (r[c].parse::<f64>().expect("t") / dt).round() as usize;
+    let last = rows.iter().map(|r| index(r, ct)).max().expect("rows");
     let events = journal(&dir.join("journal.txt"));
     assert!(events.iter().any(|e| e.1 == "page"), "the page was never swapped in");
-    let again = recompute(&events, &page, last);
+    let duration = format!("{}", (last + 1) as f64 * dt);
+    let replayed = json(
+        &bin,
+        &dir,
+        &["loop", "--replay", "journal.txt", "--params", "fitted/algebraic.json", "--trace", "loop.csv"]
+            .into_iter()
+            .chain(["--duration", &duration, "--json"])
+            .collect::<Vec<_>>(),
+    );
+    assert_eq!(replayed["page_crc"], exported["crc"], "{replayed}");
+    assert_eq!(replayed["samples"].as_u64(), Some(last as u64 + 1), "{replayed}");
+    let (lhead, lrows) = read_csv(&dir.join("loop.csv"));
+    let (lt, le, ltrue) = (col(&lhead, "t"), col(&lhead, "torque_est"), col(&lhead, "torque"));
     let mut driven = 0;
     for r in &rows {
-        let k = index(r);
+        let k = index(r, ct);
+        let l = &lrows[k];
+        assert_eq!(index(l, lt), k, "loop.csv row {k}: t {}", l[lt]);
         let est: f32 = r[ce].parse().expect("torque_est");
+        let again: f32 = l[le].parse().expect("loop torque_est");
+        assert_eq!(est.to_bits(), again.to_bits(), "sample {k}: recorded {est}, loop {again}");
         let tru: f32 = r[ctrue].parse().expect("torque");
-        assert_eq!(est.to_bits(), again[k].0.to_bits(), "sample {k}: recorded {est}, recomputed {}", again[k].0);
-        assert_eq!(tru, again[k].1 as f32, "sample {k}: true torque");
+        assert_eq!(tru.to_bits(), l[ltrue].parse::<f32>().expect("loop torque").to_bits(), "sample {k}: true torque");
         if r[cr].parse::<f64>().expect("reference") > 1.0 && est > 1.0 {
             driven += 1;
         }
@@ -298,4 +264,30 @@ fn an_injected_hall_fault_is_in_status_within_2_ms() {
     assert_eq!(first[cf], code.to_string(), "{first:?}");
     assert_eq!(status["fault"], code, "{status}");
     assert_eq!(status["fault_name"], "hall_open", "{status}");
+}
+
+#[test]
+fn a_stalled_task_starves_the_watchdog_and_the_board_resets_and_answers_again() {
+    let bin = hil_sim();
+    let dir = scratch("stall");
+    let board = virtual_board(&bin, &dir, &["--stall-tasks", "0.5"]);
+    let wait = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    let line = loop {
+        let left = wait.saturating_duration_since(std::time::Instant::now());
+        let l = board.log.recv_timeout(left).expect("a watchdog reset on stderr within 30 s");
+        if l.contains("watchdog reset at") {
+            break l;
+        }
+    };
+    let t: f64 = line
+        .split("watchdog reset at ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no time in `{line}`"));
+    // The watchdog task pets every 10 ms; the watchdog expires 50 ms after the last pet.
+    assert!((0.54..=0.551).contains(&t), "reset at {t} s for tasks stalled at 0.5 s: {line}");
+    assert!(line.contains("IndependentWatchdog"), "{line}");
+    let status = json(&bin, &dir, &["board", "--port", &board.port, "--json", "status"]);
+    assert_eq!(status["fault"], 0, "the board answers again after the reset: {status}");
 }

@@ -36,13 +36,34 @@ impl From<LoopScenarioArg> for LoopScenario {
     }
 }
 
+/// `--control-hz`'s default for the scenarios, Hz.
+const DEFAULT_CONTROL_HZ: f64 = 10_000.0;
+
+/// The longest `--replay`, samples (every one is kept for the trace).
+const MAX_REPLAY_SAMPLES: f64 = 3_600_000.0;
+
 /// `--duration`'s default for the multisine run, s.
 const DEFAULT_MULTISINE_S: f64 = 20.0;
 
 #[derive(Args, Debug)]
 pub struct LoopArgs {
-    #[arg(long, value_enum)]
-    pub scenario: LoopScenarioArg,
+    #[arg(long, value_enum, required_unless_present = "replay")]
+    pub scenario: Option<LoopScenarioArg>,
+    /// Replay a virtual board's session instead of a scenario: its `--journal` file (what
+    /// it applied at which sample), on the same clutch, seed and bench, with the page of
+    /// `--params` swapped in at the journal's `page` event; every sample to `--trace`.
+    #[arg(long, requires_all = ["params", "trace", "duration"], conflicts_with = "scenario")]
+    pub replay: Option<PathBuf>,
+    /// `fit --save` parameter file of the page the board loaded (with `--replay`).
+    #[arg(long, requires = "replay")]
+    pub params: Option<PathBuf>,
+    /// CSV of every replayed sample, `t,reference,torque_est,torque,enable,fault` (with
+    /// `--replay`).
+    #[arg(long, requires = "replay")]
+    pub trace: Option<PathBuf>,
+    /// Fault injected in the replay, NAME@SECONDS (as `virtual-board --fault`).
+    #[arg(long, requires = "replay")]
+    pub fault: Option<String>,
     /// TOML scenario file whose `[clutch]` replaces the reference clutch.
     #[arg(long)]
     pub clutch: Option<PathBuf>,
@@ -50,9 +71,11 @@ pub struct LoopArgs {
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Control-step rate, Hz.
-    #[arg(long, default_value_t = 10_000.0)]
-    pub control_hz: f64,
-    /// Duration of the multisine run, s (default 20; the other scenarios have fixed lengths).
+    /// (default 10 000 for the scenarios; with `--replay`, the board's rate, 20 000).
+    #[arg(long)]
+    pub control_hz: Option<f64>,
+    /// Duration of the multisine run, s (default 20; the other scenarios have fixed
+    /// lengths); with `--replay`, the simulated seconds replayed.
     #[arg(long)]
     pub duration: Option<f64>,
     #[arg(long, default_value_t = 1)]
@@ -75,7 +98,8 @@ pub fn run_cmd(a: LoopArgs) -> anyhow::Result<()> {
         }
         None => ClutchParams::default(),
     };
-    let scenario: LoopScenario = a.scenario.into();
+    let Some(scenario) = a.scenario else { return replay(&a, &clutch) };
+    let scenario: LoopScenario = scenario.into();
     let duration = match (a.duration, scenario) {
         (None, _) => DEFAULT_MULTISINE_S,
         (Some(d), LoopScenario::Multisine) => d,
@@ -83,7 +107,8 @@ pub fn run_cmd(a: LoopArgs) -> anyhow::Result<()> {
             anyhow::bail!("--duration applies to --scenario multisine only; `{}` has a fixed length", other.name())
         }
     };
-    let spec = LoopSpec { scenario, control_hz: a.control_hz, duration, seed: a.seed };
+    let control_hz = a.control_hz.unwrap_or(DEFAULT_CONTROL_HZ);
+    let spec = LoopSpec { scenario, control_hz, duration, seed: a.seed };
     let bar = super::progress::Bar::new(3, "identify");
     let report = evaluate(&clutch, &spec, &bar)?;
     bar.finish();
@@ -102,12 +127,59 @@ pub fn run_cmd(a: LoopArgs) -> anyhow::Result<()> {
     write_csv(&a.out, &format!("{name}_loop.csv"), &report.loop_run)?;
     write_csv(&a.out, &format!("{name}_baseline.csv"), &report.baseline_run)?;
     if a.json {
-        return super::print_json(&report_json(&report, a.control_hz));
+        return super::print_json(&report_json(&report, control_hz));
     }
-    print_text(&report, a.control_hz);
+    print_text(&report, control_hz);
     if let Some(d) = &a.out {
         super::emit(&format!("  CSV written to {}\n", Path::new(d).display()));
     }
+    Ok(())
+}
+
+/// `loop --replay JOURNAL --params P --trace OUT --duration S`.
+fn replay(a: &LoopArgs, clutch: &ClutchParams) -> anyhow::Result<()> {
+    use hil_sim::closed_loop::replay::{csv, parse_journal, replay};
+    use hil_sim::io::{config_page, params_file::ParamsFile};
+    let (Some(journal), Some(params), Some(trace), Some(duration)) = (&a.replay, &a.params, &a.trace, a.duration)
+    else {
+        anyhow::bail!("--replay needs --params, --trace and --duration")
+    };
+    let events = parse_journal(
+        &std::fs::read_to_string(journal).with_context(|| format!("reading --replay {}", journal.display()))?,
+    )
+    .with_context(|| format!("--replay {}", journal.display()))?;
+    let file = ParamsFile::read(params)?;
+    // The board's rate unless told otherwise: the page must be the one the board loaded.
+    let control_hz = a.control_hz.unwrap_or(f64::from(config_page::CONTROL_HZ));
+    let control = config_page::default_control(control_hz as f32)?;
+    let page = config_page::firmware_image(&file, params, control)?;
+    let fault = a.fault.as_deref().map(super::virtual_board::parse_fault).transpose()?;
+    if !(duration.is_finite() && duration > 0.0) {
+        anyhow::bail!("--duration {duration}: expected a positive number of seconds");
+    }
+    let samples = (duration * control_hz).round();
+    if !(1.0..=MAX_REPLAY_SAMPLES).contains(&samples) {
+        anyhow::bail!(
+            "--duration {duration} s at {control_hz} Hz: {samples} samples; a replay runs 1 to {MAX_REPLAY_SAMPLES} (3 min at 20 kHz)"
+        );
+    }
+    let samples = samples as usize;
+    let rows = replay(clutch, a.seed, fault, &events, &page, samples)
+        .with_context(|| format!("--replay {}", journal.display()))?;
+    hil_sim::io::output::write(trace, csv(&rows))?;
+    if a.json {
+        return super::print_json(&json!({
+            "replay": journal, "samples": rows.len(), "control_hz": control_hz, "page_crc": format!("{:#010x}", page.crc()), "trace": trace,
+        }));
+    }
+    super::emit(&format!(
+        "loop --replay {}: {} samples at {} Hz, page {:#010x}; trace written to {}\n",
+        journal.display(),
+        rows.len(),
+        control_hz,
+        page.crc(),
+        trace.display()
+    ));
     Ok(())
 }
 

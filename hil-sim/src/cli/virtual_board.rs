@@ -25,9 +25,14 @@ pub struct VirtualBoardArgs {
     /// Write what was applied at which sample (`K ref V`, `K enable 1`, `K page CRC`, …).
     #[arg(long)]
     pub journal: Option<PathBuf>,
+    /// Stall the application's tasks from this simulated time on, s: the modelled watchdog
+    /// (50 ms) resets the board, which starts again from flash (the plant keeps running).
+    #[arg(long)]
+    pub stall_tasks: Option<f64>,
 }
 
-fn parse_fault(s: &str) -> anyhow::Result<Schedule> {
+/// `--fault NAME@SECONDS` (also `loop --replay`).
+pub(super) fn parse_fault(s: &str) -> anyhow::Result<Schedule> {
     let names = || Injection::ALL.iter().map(|i| i.name()).collect::<Vec<_>>().join(", ");
     let Some((name, at)) = s.split_once('@') else { bail!("--fault `{s}`: expected NAME@SECONDS (NAME: {})", names()) };
     let Some(injection) = Injection::ALL.into_iter().find(|i| i.name() == name) else {
@@ -52,7 +57,10 @@ pub fn run(a: VirtualBoardArgs) -> anyhow::Result<()> {
         Some(p) => Some(Box::new(std::fs::File::create(p).with_context(|| format!("--journal {}", p.display()))?)),
         None => None,
     };
-    let opts = ServeOptions { listen: a.listen, clutch, seed, fault, journal };
+    if let Some(t) = a.stall_tasks.filter(|t| !(t.is_finite() && *t >= 0.0)) {
+        bail!("--stall-tasks {t}: expected a time in seconds");
+    }
+    let opts = ServeOptions { listen: a.listen, clutch, seed, fault, journal, stall_tasks: a.stall_tasks };
     serve(opts, &mut |addr| {
         eprintln!("virtual board listening on tcp:{addr}");
         eprintln!("ready");

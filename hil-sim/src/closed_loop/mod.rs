@@ -31,6 +31,7 @@ pub mod identify;
 pub mod injection;
 pub mod record;
 pub mod references;
+pub mod replay;
 pub mod rig;
 pub mod scenarios;
 pub mod step_response;

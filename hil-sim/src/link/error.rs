@@ -12,8 +12,10 @@ pub enum LinkError {
     Connect { port: String, source: std::io::Error },
     #[error("{port}: cannot open the serial device: {source}")]
     Serial { port: String, source: serialport::Error },
-    #[error("can:{iface}: SocketCAN is not supported by this build of hil-sim; use the board's USB serial port (/dev/ttyACM0)")]
+    #[error("can:{iface}: SocketCAN exists on Linux only; use the board's USB serial port (/dev/ttyACM0)")]
     NoCan { iface: String },
+    #[error("can:{iface}: cannot open the SocketCAN interface (a CAN adapter at the board's 1 Mbit/s: `ip link set {iface} up type can bitrate 1000000`)")]
+    CanOpen { iface: String, source: std::io::Error },
     #[error("{port}: no answer to {what} within {ms} ms (board off, firmware not running, or the wrong port?)")]
     Timeout { port: String, what: &'static str, ms: u64 },
     #[error("{port}: the board stopped answering while {what} (no frame for {ms} ms)")]

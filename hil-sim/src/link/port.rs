@@ -28,7 +28,7 @@ pub fn open(port: &str) -> Result<Box<dyn Stream>, LinkError> {
         return Ok(Box::new(s));
     }
     if let Some(iface) = port.strip_prefix("can:") {
-        return Err(LinkError::NoCan { iface: iface.to_owned() });
+        return open_can(iface);
     }
     if port.is_empty() || port.contains(':') {
         return Err(LinkError::BadPort(port.to_owned()));
@@ -38,4 +38,18 @@ pub fn open(port: &str) -> Result<Box<dyn Stream>, LinkError> {
         .open()
         .map_err(|source| LinkError::Serial { port: port.to_owned(), source })?;
     Ok(Box::new(s))
+}
+
+/// `can:IFACE` on Linux: a SocketCAN raw socket ([`super::can`]).
+#[cfg(target_os = "linux")]
+fn open_can(iface: &str) -> Result<Box<dyn Stream>, LinkError> {
+    match super::can::CanStream::open(iface, POLL) {
+        Ok(s) => Ok(Box::new(s)),
+        Err(source) => Err(LinkError::CanOpen { iface: iface.to_owned(), source }),
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn open_can(iface: &str) -> Result<Box<dyn Stream>, LinkError> {
+    Err(LinkError::NoCan { iface: iface.to_owned() })
 }

@@ -1,0 +1,152 @@
+//! The configuration store: what a slot holds, which configuration boots, and a commit
+//! (validate the page, write it to the slot not running, read it back, hand it to the
+//! control interrupt).
+
+use core::sync::atomic::Ordering;
+
+use model_core::control::page::PAGE_BYTES;
+use model_core::control::{ConfigImage, PageError, ValidatedConfig};
+use model_core::protocol::Nack;
+
+use super::ports::{Clock, ControlPort, Event, Events, FlashPages};
+use super::App;
+use crate::bringup::{self, BoardMismatch};
+use crate::runner::Loop;
+use crate::slots::{self, Boot, Slot, SlotState};
+
+/// A page error for the log (a name: formatting the numbers in it would pull core's float
+/// formatting into the board's flash; `hil-sim export` gives the full message on the host).
+pub fn page_error(e: &PageError) -> &'static str {
+    match e {
+        PageError::BadMagic => "blank or foreign page",
+        PageError::UnsupportedVersion(_) => "unsupported format version",
+        PageError::Malformed(what) => what,
+        PageError::CrcMismatch { .. } => "CRC mismatch",
+        PageError::Invalid(_) => "settings or model parameters out of range",
+        PageError::WrongModel => "model not built into this firmware",
+    }
+}
+
+/// Which configuration runs, as the debugger and the emulator read it: `seq << 2 | slot`
+/// with slot 1 = A, 2 = B; 0 = compiled-in defaults on a blank board, 3 = defaults because
+/// the slots are damaged.
+pub fn source_code(running: Option<(Slot, u32)>, damaged: bool) -> u32 {
+    match running {
+        Some((Slot::A, seq)) => seq << 2 | 1,
+        Some((Slot::B, seq)) => seq << 2 | 2,
+        None if damaged => 3,
+        None => 0,
+    }
+}
+
+/// A decoded page as a controller, checked against the board (timer counts, period,
+/// comparator range).
+pub fn runnable(img: &ConfigImage) -> Result<(Loop, ValidatedConfig), PageError> {
+    bringup::check_board(&img.control, bringup::PWM_COUNTS).map_err(|m| match m {
+        BoardMismatch::PwmCounts => PageError::Malformed("pwm_counts is not the timer's"),
+        BoardMismatch::SamplePeriod => PageError::Malformed("dt is not the control period"),
+        BoardMismatch::OverCurrentRange => PageError::Malformed("over_current beyond the comparator"),
+    })?;
+    Loop::from_image(img).map(|lp| (lp, img.control))
+}
+
+/// What one slot holds, and its controller when it holds a usable page.
+pub fn inspect(flash: &impl FlashPages, slot: Slot) -> (SlotState, Option<(Loop, ValidatedConfig)>) {
+    let Ok(bytes) = flash.read(slot) else {
+        return (SlotState::Unusable("uncorrectable ECC error"), None);
+    };
+    if slots::is_blank(&bytes) {
+        return (SlotState::Blank, None);
+    }
+    let seq = match slots::record_of(&bytes) {
+        slots::Record::Committed(seq) => seq,
+        slots::Record::Absent => 0,
+        slots::Record::Broken => return (SlotState::Unusable("commit record cut (interrupted commit)"), None),
+    };
+    let image = bytes.get(..slots::IMAGE_BYTES).unwrap_or(&[]);
+    match ConfigImage::decode(image).and_then(|img| runnable(&img)) {
+        Ok(c) => (SlotState::Valid(seq), Some(c)),
+        Err(e) => (SlotState::Unusable(page_error(&e)), None),
+    }
+}
+
+/// The configuration that boots.
+pub struct Loaded {
+    pub lp: Loop,
+    pub cfg: ValidatedConfig,
+    /// The slot and commit it came from; `None`: the compiled-in defaults.
+    pub running: Option<(Slot, u32)>,
+    /// No slot held a usable page (the loop is held in a fault until a commit).
+    pub damaged: bool,
+    /// CRC-32 of the page it came from (0: the compiled-in defaults).
+    pub crc: u32,
+}
+
+/// CRC-32 of the page in `slot` (0 when it does not read or decode).
+fn slot_crc(flash: &impl FlashPages, slot: Slot) -> u32 {
+    let Ok(bytes) = flash.read(slot) else { return 0 };
+    ConfigImage::decode(bytes.get(..slots::IMAGE_BYTES).unwrap_or(&[])).map_or(0, |img| img.crc())
+}
+
+/// The newer valid slot, or the defaults (blank board), or the defaults with `damaged`
+/// set. `Err`: the compiled-in configuration itself is refused (a build error).
+pub fn load(flash: &impl FlashPages, events: &impl Events) -> Result<Loaded, PageError> {
+    let (sa, ca) = inspect(flash, Slot::A);
+    let (sb, cb) = inspect(flash, Slot::B);
+    events.event(Event::Slots(sa, sb));
+    let boot = slots::choose(sa, sb);
+    let chosen = match boot {
+        Boot::Slot(Slot::A, _) => ca,
+        Boot::Slot(Slot::B, _) => cb,
+        Boot::Blank | Boot::Damaged => None,
+    };
+    if let (Boot::Slot(slot, seq), Some((lp, cfg))) = (boot, chosen) {
+        events.event(Event::Loaded(slot, seq));
+        let crc = slot_crc(flash, slot);
+        return Ok(Loaded { lp, cfg, running: Some((slot, seq)), damaged: false, crc });
+    }
+    let damaged = boot == Boot::Damaged;
+    events.event(if damaged { Event::Damaged } else { Event::Blank });
+    let (lp, cfg) = bringup::default_image().and_then(|img| runnable(&img))?;
+    Ok(Loaded { lp, cfg, running: None, damaged, crc: 0 })
+}
+
+/// Validate the received page, write it to the slot not running (erase, image, commit
+/// record last; the flash waits yield), read it back, hand it to the control interrupt.
+/// The new (slot, commit).
+pub async fn commit<C: Clock, F: FlashPages, P: ControlPort, E: Events>(
+    app: App<'_, C, F, P, E>,
+    bytes: &[u8; PAGE_BYTES],
+    img: &ConfigImage,
+    running: Option<(Slot, u32)>,
+) -> Result<(Slot, u32), Nack> {
+    if app.ctl.enabled() {
+        return Err(Nack::Busy);
+    }
+    // Checked now, built again once written: a controller held across the flash waits
+    // would sit in both link tasks' futures (11 KB each with every model built in).
+    runnable(img).map(drop).map_err(|_| Nack::InvalidPage)?;
+    let (slot, seq) = slots::commit_target(running);
+    let image = slots::slot_image(bytes, seq).ok_or(Nack::InvalidPage)?;
+    app.flash.program(slot, &image).await.map_err(|e| {
+        app.events.event(Event::CommitFailed(slot, e));
+        Nack::Flash
+    })?;
+    match inspect(app.flash, slot) {
+        (SlotState::Valid(s), _) if s == seq => {}
+        (state, _) => {
+            app.events.event(Event::ReadBack(slot, state));
+            return Err(Nack::Flash);
+        }
+    }
+    let (lp, cfg) = runnable(img).map_err(|_| Nack::InvalidPage)?;
+    let model = lp.model_id();
+    app.ctl.hand_over(lp, cfg, img.crc());
+    // A board held by a damaged configuration runs again once a good page is committed.
+    if app.shared.damaged.swap(false, Ordering::Relaxed) {
+        app.ctl.request_reset();
+    }
+    app.ctl.running(Some((slot, seq)), false);
+    app.events.event(Event::Committed(model, slot, seq));
+    Ok((slot, seq))
+}
