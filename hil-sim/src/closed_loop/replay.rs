@@ -129,6 +129,7 @@ pub fn replay(
                     let (l, c) = runnable(page)?;
                     *lp = l;
                     cfg = c;
+                    rig.set_dt(f64::from(cfg.get().dt));
                 }
             }
         }

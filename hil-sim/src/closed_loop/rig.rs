@@ -74,8 +74,13 @@ pub struct Rig {
     slow_every: usize,
     /// Temperature compensation configured (decided once, at the start).
     use_temp: bool,
+    /// Time step, s (the running page's control period).
     dt: f64,
     k: usize,
+    /// Samples and time, s, at the last change of time step (a page at another control
+    /// rate): time is `t0 + (k - k0)·dt`, the slow pass every `slow_every` samples from `k0`.
+    k0: usize,
+    t0: f64,
 }
 
 impl Rig {
@@ -93,7 +98,31 @@ impl Rig {
             use_temp: cfg.get().temp_coeff != 0.0,
             dt,
             k: 0,
+            k0: 0,
+            t0: 0.0,
         }
+    }
+
+    /// From the next sample on, step at `dt`, s (a page swapped in at another control
+    /// rate; the firmware's repetition counter changes the same way).
+    pub fn set_dt(&mut self, dt: f64) {
+        if dt == self.dt || !(dt.is_finite() && dt > 0.0) {
+            return;
+        }
+        self.t0 = self.time();
+        self.k0 = self.k;
+        self.dt = dt;
+        self.slow_every = ((1e-3 / dt).round() as usize).max(1);
+    }
+
+    /// Time of the next sample, s.
+    pub fn time(&self) -> f64 {
+        self.t0 + (self.k - self.k0) as f64 * self.dt
+    }
+
+    /// The time step, s.
+    pub fn dt(&self) -> f64 {
+        self.dt
     }
 
     /// Samples run so far.
@@ -103,7 +132,7 @@ impl Rig {
 
     /// Run one sample of `ctrl` with configuration `cfg` (a configuration fault changes it).
     pub fn sample(&mut self, ctrl: &mut dyn Controller, cfg: &mut ValidatedConfig, cmd: Command) -> Sampled {
-        let t = self.k as f64 * self.dt;
+        let t = self.time();
         let active = self.fault.filter(|f| t >= f.at).map(|f| f.injection);
         if let (Some(inj), false) = (active, self.injected) {
             self.injected = true;
@@ -111,7 +140,7 @@ impl Rig {
         }
         let overrun = active == Some(Injection::Overrun);
         let m = self.plant.measure();
-        if self.k.is_multiple_of(self.slow_every) {
+        if (self.k - self.k0).is_multiple_of(self.slow_every) {
             ctrl.slow(cfg, if self.use_temp { m.temperature as f32 } else { f32::NAN });
         }
         let input = ControlInput {

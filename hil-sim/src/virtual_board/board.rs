@@ -29,7 +29,6 @@ pub struct VirtualBoard {
     cmd: Command,
     last: Option<Sampled>,
     journal: Journal,
-    dt: f64,
 }
 
 impl VirtualBoard {
@@ -49,7 +48,6 @@ impl VirtualBoard {
             cmd: Command { reference: 0.0, enable: false, reset: false },
             last: None,
             journal,
-            dt: f64::from(cfg.get().dt),
         }
     }
 
@@ -57,6 +55,7 @@ impl VirtualBoard {
     pub fn reboot(&mut self, lp: Loop, cfg: ValidatedConfig) {
         *self.lp = lp;
         self.cfg = cfg;
+        self.rig.set_dt(f64::from(cfg.get().dt));
     }
 
     /// Samples run.
@@ -64,14 +63,9 @@ impl VirtualBoard {
         self.rig.samples()
     }
 
-    /// The control rate, Hz.
-    pub fn control_hz(&self) -> f64 {
-        1.0 / self.dt
-    }
-
-    /// Simulated time of sample `k`, µs.
-    pub fn time_us(&self, k: usize) -> u64 {
-        (k as f64 * self.dt * 1e6).round() as u64
+    /// Simulated time of the next sample, µs.
+    pub fn time_us(&self) -> u64 {
+        (self.rig.time() * 1e6).round() as u64
     }
 
     fn log(&mut self, what: std::fmt::Arguments) {
@@ -91,6 +85,8 @@ impl VirtualBoard {
                 let (lp, cfg, crc) = *p;
                 *self.lp = lp;
                 self.cfg = cfg;
+                // Its control rate from this sample on (the board's repetition counter).
+                self.rig.set_dt(f64::from(cfg.get().dt));
                 self.log(format_args!("page {crc:#010x}"));
             }
         }
@@ -118,7 +114,7 @@ impl VirtualBoard {
         ctl.last.set(Snapshot { out: s.out, reference, supply_v: f32::NAN, cycles: 0 });
         let d = ctl.decimation.get();
         if d != 0 && k.is_multiple_of(d) {
-            let t_us = self.time_us(k as usize) as u32;
+            let t_us = (s.t * 1e6).round() as u64 as u32;
             ctl.stream.borrow_mut().push(StreamSample {
                 n: k,
                 t_us,

@@ -161,13 +161,13 @@ fn run_boot(
         application::telemetry::run(app),
         application::watchdog::run(app, &mut wd),
     ));
-    let hz = board.control_hz();
     loop {
         net.receive()?;
-        let due = (start.elapsed().as_secs_f64() * hz) as usize;
+        // Simulated real time: every sample whose time has come on the wall clock.
+        let due_us = start.elapsed().as_micros() as u64;
         let mut ran = 0;
-        while board.samples() < due && ran < BURST {
-            clock.set(board.time_us(board.samples()));
+        while board.time_us() <= due_us && ran < BURST {
+            clock.set(board.time_us());
             // The tasks never end (`-> !`); polled before every sample.
             if stall_us.is_none_or(|t| clock.now_us() < t) {
                 let _ = poll_once(tasks.as_mut());
