@@ -150,3 +150,125 @@ pub async fn commit<C: Clock, F: FlashPages, P: ControlPort, E: Events>(
     app.events.event(Event::Committed(model, slot, seq));
     Ok((slot, seq))
 }
+
+#[cfg(test)]
+mod tests {
+    use core::cell::{Cell, RefCell};
+    use core::future::Future;
+    use core::pin::pin;
+    use core::task::{Context, Poll, Waker};
+
+    use model_core::protocol::device::StatusFigures;
+
+    use super::*;
+    use crate::application::ports::{EccError, FlashFault};
+    use crate::application::{Shared, Snapshot, StreamSample};
+    use crate::slots::SLOT_BYTES;
+
+    /// Runs a future whose waits are all ready at once.
+    fn block_on<F: Future>(f: F) -> F::Output {
+        let mut f = pin!(f);
+        loop {
+            if let Poll::Ready(o) = f.as_mut().poll(&mut Context::from_waker(Waker::noop())) {
+                return o;
+            }
+        }
+    }
+
+    struct Now;
+    impl Clock for Now {
+        fn now_us(&self) -> u64 {
+            0
+        }
+        async fn at(&self, _: u64) {}
+    }
+
+    struct Pages(RefCell<[[u8; SLOT_BYTES]; 2]>);
+    impl FlashPages for Pages {
+        fn read(&self, slot: Slot) -> Result<[u8; SLOT_BYTES], EccError> {
+            Ok(self.0.borrow()[slot as usize])
+        }
+        async fn program(&self, slot: Slot, image: &[u8; SLOT_BYTES]) -> Result<(), FlashFault> {
+            self.0.borrow_mut()[slot as usize] = *image;
+            Ok(())
+        }
+    }
+
+    #[derive(Default)]
+    struct Ctl {
+        enabled: Cell<bool>,
+        handed: Cell<Option<u32>>,
+        source: Cell<u32>,
+    }
+    impl ControlPort for Ctl {
+        fn set_reference(&self, _: f32) {}
+        fn set_enable(&self, on: bool) {
+            self.enabled.set(on);
+        }
+        fn enabled(&self) -> bool {
+            self.enabled.get()
+        }
+        fn request_reset(&self) {}
+        fn status(&self) -> StatusFigures {
+            StatusFigures::default()
+        }
+        fn snapshot(&self) -> Snapshot {
+            Snapshot::EMPTY
+        }
+        fn overruns(&self) -> u32 {
+            0
+        }
+        fn samples(&self) -> u32 {
+            0
+        }
+        fn stalled(&self) -> bool {
+            false
+        }
+        fn stall(&self) {}
+        fn request_slow_pass(&self) {}
+        fn hand_over(&self, _: Loop, _: ValidatedConfig, crc: u32) {
+            self.handed.set(Some(crc));
+        }
+        fn running(&self, running: Option<(Slot, u32)>, damaged: bool) {
+            self.source.set(source_code(running, damaged));
+        }
+        fn set_stream_decimation(&self, _: u32) {}
+        fn pop_stream(&self) -> Option<StreamSample> {
+            None
+        }
+    }
+
+    struct Quiet;
+    impl Events for Quiet {
+        fn event(&self, _: Event) {}
+    }
+
+    fn page() -> (ConfigImage, [u8; PAGE_BYTES]) {
+        let img = bringup::default_image().expect("default page");
+        let bytes = img.encode();
+        (img, bytes)
+    }
+
+    #[test]
+    fn a_commit_is_refused_while_driven_and_otherwise_boots_from_its_slot() {
+        let flash = Pages(RefCell::new([[0xFF; SLOT_BYTES]; 2]));
+        let (ctl, shared) = (Ctl::default(), Shared::new(None, false));
+        let app = App { clock: &Now, flash: &flash, ctl: &ctl, events: &Quiet, shared: &shared };
+        let (img, bytes) = page();
+        ctl.enabled.set(true);
+        assert_eq!(block_on(commit(app, &bytes, &img, None)), Err(Nack::Busy));
+        assert!(slots::is_blank(&flash.0.borrow()[0]), "nothing written while driven");
+        ctl.enabled.set(false);
+        let (slot, seq) = block_on(commit(app, &bytes, &img, None)).expect("commit");
+        assert_eq!(ctl.handed.get(), Some(img.crc()), "the controller handed to the interrupt");
+        assert_eq!(ctl.source.get(), source_code(Some((slot, seq)), false));
+        let boot = load(&flash, &Quiet).expect("boot");
+        assert_eq!(boot.running, Some((slot, seq)), "the next boot runs the committed slot");
+        assert!(!boot.damaged);
+        // The next commit goes to the other slot with a newer sequence.
+        let (slot2, seq2) = block_on(commit(app, &bytes, &img, boot.running)).expect("second commit");
+        assert_ne!(slot2, slot);
+        assert!(slots::newer(seq, seq2), "commit {seq2} is newer than {seq}");
+        assert_eq!(load(&flash, &Quiet).expect("boot").running, Some((slot2, seq2)));
+    }
+}
