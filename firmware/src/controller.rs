@@ -60,6 +60,11 @@ pub static RESET: AtomicBool = AtomicBool::new(false);
 /// Samples processed and overruns since start-up.
 pub static SAMPLES: AtomicU32 = AtomicU32::new(0);
 pub static OVERRUNS: AtomicU32 = AtomicU32::new(0);
+/// The last sample's mode and latched fault (`mode_code << 8 | fault code`) and torque
+/// estimate (f32 bits, N·m), stored every sample: what `status` answers, so a fault is in
+/// the reply from the period it latched in (the 10 Hz snapshot is only the log's).
+pub static STATUS_MODE_FAULT: AtomicU32 = AtomicU32::new(0);
+pub static STATUS_TORQUE: AtomicU32 = AtomicU32::new(0);
 /// The control interrupt stopped (deadline monitor or watchdog task), or no usable
 /// configuration: the bridge stays off and the step is told of an overrun (so it latches
 /// the `Overrun` fault when enabled) until a reset command.
@@ -179,6 +184,11 @@ fn ADC1_2() {
         let out = c.lp.step(&c.cfg, input);
         drive(c, &out, stalled);
         let n = SAMPLES.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
+        STATUS_MODE_FAULT.store(
+            u32::from(model_core::protocol::mode_code(out.mode)) << 8 | u32::from(out.fault.code()),
+            Ordering::Relaxed,
+        );
+        STATUS_TORQUE.store(out.torque_est.to_bits(), Ordering::Relaxed);
         c.t_us = c.t_us.wrapping_add(c.period_us);
         RUNNING.store(true, Ordering::Relaxed);
         let cycles = cortex_m::peripheral::DWT::cycle_count().wrapping_sub(t0);

@@ -252,7 +252,7 @@ mod tests {
     #[test]
     fn a_commit_is_refused_while_driven_and_otherwise_boots_from_its_slot() {
         let flash = Pages(RefCell::new([[0xFF; SLOT_BYTES]; 2]));
-        let (ctl, shared) = (Ctl::default(), Shared::new(None, false));
+        let (ctl, shared) = (Ctl::default(), Shared::new(None, false, 0));
         let app = App { clock: &Now, flash: &flash, ctl: &ctl, events: &Quiet, shared: &shared };
         let (img, bytes) = page();
         ctl.enabled.set(true);
@@ -265,6 +265,9 @@ mod tests {
         let boot = load(&flash, &Quiet).expect("boot");
         assert_eq!(boot.running, Some((slot, seq)), "the next boot runs the committed slot");
         assert!(!boot.damaged);
+        assert_eq!(boot.crc, img.crc(), "the page-CRC query answers the booted page's CRC");
+        let blank = Pages(RefCell::new([[0xFF; SLOT_BYTES]; 2]));
+        assert_eq!(load(&blank, &Quiet).expect("blank boot").crc, 0, "the compiled-in defaults answer 0");
         // The next commit goes to the other slot with a newer sequence.
         let (slot2, seq2) = block_on(commit(app, &bytes, &img, boot.running)).expect("second commit");
         assert_ne!(slot2, slot);

@@ -69,12 +69,13 @@ impl ControlPort for Interrupts {
         controller::RESET.store(true, Ordering::Relaxed);
     }
     fn status(&self) -> StatusFigures {
-        let s = self.snapshot();
+        // The last sample's (stored every period), not the 10 Hz snapshot's.
+        let mf = controller::STATUS_MODE_FAULT.load(Ordering::Relaxed);
         StatusFigures {
-            mode: mode_code(s.out.mode),
-            fault: s.out.fault.code(),
+            mode: (mf >> 8) as u8,
+            fault: mf as u8,
             overruns: self.overruns(),
-            torque_est: s.out.torque_est,
+            torque_est: f32::from_bits(controller::STATUS_TORQUE.load(Ordering::Relaxed)),
         }
     }
     fn snapshot(&self) -> Snapshot {
