@@ -472,6 +472,7 @@ class Machine:
         uc.mem_map(FLASH, SLOT_A - FLASH)
         uc.mmio_map(SLOT_A, 0x1000, self._slot_rd, None, self._slot_wr, None)
         uc.mem_map(0x2000_0000, 128 * 1024)
+        uc.mem_map(0x1000_0000, 32 * 1024)  # CCM SRAM (memory.x: `.ccmram`, the Preisach slots)
         uc.mem_map(0x1FFF_0000, 0x10000)  # system memory: UID, flash size, package
         uc.mem_map(TRAMPOLINE, 0x1000)
         uc.mem_write(TRAMPOLINE, b"\xfe\xe7" * 8)  # b .

@@ -86,9 +86,10 @@ def reference(k):
     return 1.0 + 0.8 * math.sin(2 * math.pi * 5 * k / 20_000)
 
 
-def control(elf, periods, trace_csv):
-    """Closed loop from reset: every period's inputs and what the interrupt wrote."""
-    m = g474.Machine(elf)
+def control(elf, periods, trace_csv, flash_path=None):
+    """Closed loop from reset (from the configuration slots in `flash_path` when given):
+    every period's inputs and what the interrupt wrote."""
+    m = g474.Machine(elf, flash_image=open(flash_path, "rb").read() if flash_path else None)
     plant = Plant()
     addr = {k: sym(m, p) for k, p in [("en", "controller6ENABLE"), ("ref", "controller9REFERENCE"),
                                        ("reset", "controller5RESET"), ("stall", "controller7STALLED"),
@@ -99,10 +100,11 @@ def control(elf, periods, trace_csv):
     supply = 2200
     supply_v = supply * (3.3 / 4095 * 11)
     driven = 0
+    start = None  # the first period with a control step (a Preisach page boots in ~350)
     for k in range(periods):
-        if k == 100:
+        if start is not None and k == start + 100:
             m.can.receive(m, 0x120, bytes([0x02, 1]))
-        elif k > 100 and k % 20 == 0:
+        elif start is not None and k > start + 100 and k % 20 == 0:
             # The set-point streamed at 1 kHz (the command timeout is 100 ms).
             m.can.receive(m, 0x120, bytes([0x01]) + struct.pack("<f", reference(k)))
         h, i, s = plant.sample(supply)
@@ -110,6 +112,8 @@ def control(elf, periods, trace_csv):
         slow0, n0 = m.read_u32(addr["slow"]), m.read_u32(addr["n"])
         m.period((h, i, s))
         ran = m.read_u32(addr["n"]) - n0
+        if ran and start is None:
+            start = k
         if ran > 1 or (ran == 0 and n0 > 0):
             raise AssertionError("period %d: %d control steps instead of 1" % (k, ran))
         slow = m.read_u32(addr["slow"]) - slow0
@@ -121,7 +125,7 @@ def control(elf, periods, trace_csv):
     out.close()
     if m.can.sent[:1] != [(0x121, bytes([0x82, 0x02]))]:
         raise AssertionError("no ack of the enable command: %r" % m.can.sent[:3])
-    print("control: %d periods traced from reset (%.2f s at 20 kHz), bridge driving in %d" % (periods, periods / 20000, driven))
+    print("control: %d periods traced from reset (first control step in period %d), bridge driving in %d" % (periods, start if start is not None else -1, driven))
 
 
 def running(m, periods=200):
@@ -337,7 +341,7 @@ def main():
         board(elf)
         return
     if what == "control":
-        control(elf, int(sys.argv[3]), sys.argv[4])
+        control(elf, int(sys.argv[3]), sys.argv[4], sys.argv[5] if len(sys.argv) > 5 else None)
         return
     res = faults(elf) if what == "faults" else powercut(elf, sys.argv[3], sys.argv[4])
     p = sum(res)

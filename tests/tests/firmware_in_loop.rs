@@ -23,7 +23,7 @@ use firmware::bridge::{compares, Action, Bridge};
 use firmware::bringup::{default_image, supply_volts, PWM_COUNTS};
 use firmware::slots;
 use model_core::control::page::PAGE_BYTES;
-use model_core::control::{ConfigImage, ControlInput, ControlStep};
+use model_core::control::{ConfigImage, ControlInput, ControlOutput, ControlStep};
 use model_core::models::algebraic::Algebraic;
 
 struct Fil {
@@ -103,9 +103,26 @@ fn one_second_of_control_matches_model_core() {
     let rate = img.rate.build(cfg.get().dt).expect("rate");
     let step = ControlStep::new(img.model::<Algebraic>().expect("model"), rate).expect("step");
     let mut st = step.state();
+    let text = std::fs::read_to_string(&trace).expect("trace");
+    let (compared, driving, nonzero) = compare_trace(&text, |input, slow| {
+        let out = step.step(&cfg, &mut st, input);
+        if slow {
+            step.slow(&cfg, &mut st, f32::NAN);
+        }
+        out
+    });
+    println!("compare values equal to model-core's ControlStep on {compared} samples ({driving} driving, {nonzero} non-zero)");
+    assert!(compared >= 20_000, "only {compared} samples");
+    assert!(nonzero > 15_000, "the loop hardly drove the bridge: {nonzero} non-zero compares");
+}
+
+/// Every traced period of `text` (`control`'s CSV) against `step` (the control step, and
+/// the slow pass after it when the interrupt ran one): the compares and MOE the interrupt
+/// wrote must be the ones the bridge sequencing gives for the step's output. Returns
+/// (periods compared, periods driving, periods with non-zero compares).
+fn compare_trace(text: &str, mut step: impl FnMut(ControlInput, bool) -> ControlOutput) -> (usize, usize, usize) {
     let mut bridge = Bridge::Off;
     let (mut moe, mut compared, mut driving, mut nonzero) = (false, 0usize, 0usize, 0usize);
-    let text = std::fs::read_to_string(&trace).expect("trace");
     for (line, row) in text.lines().skip(1).enumerate() {
         let v: Vec<u64> = row.split(',').map(|x| x.parse().expect("number")).collect();
         let &[ran, hall, current, supply, enable, reference, reset, stalled, slow, ccr1, ccr2, moe_seen] = v.as_slice()
@@ -126,7 +143,7 @@ fn one_second_of_control_matches_model_core() {
                 f32::from_bits(reference as u32),
             )
         };
-        let out = step.step(&cfg, &mut st, input);
+        let out = step(input, slow != 0);
         let (next, action) = bridge.next(out.pwm_enable && stalled == 0);
         bridge = next;
         let want = match action {
@@ -140,16 +157,49 @@ fn one_second_of_control_matches_model_core() {
         };
         assert_eq!((ccr1 as u32, ccr2 as u32), want, "trace line {}: compares (mode {:?})", line + 2, out.mode);
         assert_eq!(moe_seen != 0, moe, "trace line {}: MOE", line + 2);
-        if slow != 0 {
-            step.slow(&cfg, &mut st, f32::NAN);
-        }
         compared += 1;
         driving += usize::from(moe);
         nonzero += usize::from(want != (0, 0));
     }
-    println!("compare values equal to model-core's ControlStep on {compared} samples ({driving} driving, {nonzero} non-zero)");
-    assert!(compared >= 20_000, "only {compared} samples");
-    assert!(nonzero > 15_000, "the loop hardly drove the bridge: {nonzero} non-zero compares");
+    (compared, driving, nonzero)
+}
+
+/// A Preisach page at its 10 kHz (issue 17: every clutch model on the board; its 10 KB
+/// table is built in place in CCM SRAM).
+fn preisach_page() -> ConfigImage {
+    let d = default_image().expect("default image");
+    let mut c = *d.control.get();
+    c.dt = 1.0 / firmware::runner::control_hz_of("preisach").expect("a rate") as f32;
+    let control = c.validate().expect("valid");
+    ConfigImage::new("preisach", &[1.0, 2.0, 0.1, 0.05, 0.1, 1.0, -1.0, 1.0, 0.0], d.rate, control).expect("page")
+}
+
+#[test]
+fn a_preisach_page_boots_from_its_slot_and_runs_as_the_runner_does() {
+    let Some(f) = fil() else { return };
+    let img = preisach_page();
+    let mut flash = slots::slot_image(&img.encode(), 1).expect("fits a slot").to_vec();
+    flash.extend([0xFF; slots::SLOT_BYTES]);
+    let flash_path = f.scratch.join("flash-preisach.bin");
+    std::fs::write(&flash_path, flash).expect("write");
+    let trace = f.scratch.join("control-preisach.csv");
+    run(&f, &["control", "6000", trace.to_str().expect("utf-8 path"), flash_path.to_str().expect("utf-8 path")]);
+
+    let mut lp = firmware::runner::Loop::from_image(&img).expect("the runner builds the page");
+    let cfg = img.control;
+    let text = std::fs::read_to_string(&trace).expect("trace");
+    let (compared, driving, nonzero) = compare_trace(&text, |input, slow| {
+        let out = lp.step(&cfg, input);
+        if slow {
+            lp.slow(&cfg, f32::NAN);
+        }
+        out
+    });
+    println!(
+        "preisach from slot A: {compared} periods equal to firmware::runner ({driving} driving, {nonzero} non-zero)"
+    );
+    assert!(compared >= 5_000, "only {compared} samples");
+    assert!(nonzero > 1_000, "the loop hardly drove the bridge: {nonzero} non-zero compares");
 }
 
 #[test]
