@@ -138,16 +138,31 @@ fn multisine_profile(path: &Path) {
 
 #[test]
 fn load_enable_record_fit_and_the_same_numbers_as_loop() {
+    record_fit_and_replay("algebraic", 20_000.0);
+}
+
+/// A model the board runs at 10 kHz: the board boots at 20 kHz and changes its step at the
+/// swap; `loop --replay` follows it sample for sample.
+#[test]
+fn a_page_at_its_own_control_rate_gives_the_same_numbers_as_loop() {
+    record_fit_and_replay("gpi", 10_000.0);
+}
+
+/// Fit `model` on a simulated run, load it on a virtual board, record 3 s driven by a
+/// multisine, fit the recording, and replay the board's journal with `loop`: every recorded
+/// sample equals the loop's sample at the same time, to the bit. `hz` is the page's rate.
+fn record_fit_and_replay(model: &str, hz: f64) {
     let bin = hil_sim();
-    let dir = scratch("record");
+    let dir = scratch(&format!("record-{model}"));
+    let fitted = format!("fitted/{model}.json");
     run(&bin, &dir, &["simulate", "--scenario", "sine_1hz", "--out", "sim.csv"]);
-    run(&bin, &dir, &["fit", "sim.csv", "--model", "algebraic", "--save", "fitted", "--json"]);
-    let exported = json(&bin, &dir, &["export", "fitted/algebraic.json", "--out", "page.bin", "--json"]);
+    run(&bin, &dir, &["fit", "sim.csv", "--model", model, "--save", "fitted", "--json"]);
+    let exported = json(&bin, &dir, &["export", &fitted, "--out", "page.bin", "--json"]);
     multisine_profile(&dir.join("profile.csv"));
 
     let board = virtual_board(&bin, &dir, &["--journal", "journal.txt"]);
     let p = board.port.as_str();
-    let loaded = json(&bin, &dir, &["board", "--port", p, "--json", "load", "fitted/algebraic.json"]);
+    let loaded = json(&bin, &dir, &["board", "--port", p, "--json", "load", &fitted]);
     assert_eq!(loaded["ok"], true, "{loaded}");
     assert_eq!(loaded["crc"], exported["crc"], "the board verified another page than `export` writes");
     assert!(loaded["bytes"].as_u64().is_some_and(|b| b > 0), "{loaded}");
@@ -171,13 +186,14 @@ fn load_enable_record_fit_and_the_same_numbers_as_loop() {
         ],
     );
     drop(board);
-    // 3 s at every 10th sample of 20 kHz; nothing lost on TCP.
-    let samples = rec["samples"].as_u64().expect("samples");
-    assert!((5900..=6000).contains(&samples), "{rec}");
+    // 3 s at every 10th sample of the page's rate; nothing lost on TCP.
+    let samples = rec["samples"].as_u64().expect("samples") as f64;
+    let want = 3.0 * hz / 10.0;
+    assert!(samples >= 0.98 * want && samples <= want, "{rec}");
     assert_eq!(rec["lost_frames"], 0, "{rec}");
 
     // The recording is fitted as it is (columns t, b, torque).
-    let fit = json(&bin, &dir, &["fit", "rec.csv", "--model", "algebraic", "--json"]);
+    let fit = json(&bin, &dir, &["fit", "rec.csv", "--model", model, "--json"]);
     let r2 = fit["results"][0]["heldout"]["r2"].as_f64().expect("r2");
     assert!(r2 > 0.9, "fit of the recorded CSV: held-out R² {r2}");
 
@@ -185,35 +201,37 @@ fn load_enable_record_fit_and_the_same_numbers_as_loop() {
     let (head, rows) = read_csv(&dir.join("rec.csv"));
     let (ct, ce, cr, ctrue) =
         (col(&head, "t"), col(&head, "torque_est"), col(&head, "reference"), col(&head, "torque"));
-    let dt = 1.0 / 20_000.0;
-    // The sample index of a row by its time stamp in column `c`.
-    let index = |r: &Vec<String>, c: usize| (r[c].parse::<f64>().expect("t") / dt).round() as usize;
-    let last = rows.iter().map(|r| index(r, ct)).max().expect("rows");
+    let t_of = |r: &Vec<String>, c: usize| r[c].parse::<f64>().expect("t");
+    let last = rows.iter().map(|r| t_of(r, ct)).fold(0.0, f64::max);
     let events = journal(&dir.join("journal.txt"));
     assert!(events.iter().any(|e| e.1 == "page"), "the page was never swapped in");
-    let duration = format!("{}", (last + 1) as f64 * dt);
+    let duration = format!("{}", last + 0.75 / hz);
     let replayed = json(
         &bin,
         &dir,
-        &["loop", "--replay", "journal.txt", "--params", "fitted/algebraic.json", "--trace", "loop.csv"]
+        &["loop", "--replay", "journal.txt", "--params", &fitted, "--trace", "loop.csv"]
             .into_iter()
             .chain(["--duration", &duration, "--json"])
             .collect::<Vec<_>>(),
     );
     assert_eq!(replayed["page_crc"], exported["crc"], "{replayed}");
-    assert_eq!(replayed["samples"].as_u64(), Some(last as u64 + 1), "{replayed}");
+    assert_eq!(replayed["control_hz"].as_f64(), Some(hz), "{replayed}");
     let (lhead, lrows) = read_csv(&dir.join("loop.csv"));
     let (lt, le, ltrue) = (col(&lhead, "t"), col(&lhead, "torque_est"), col(&lhead, "torque"));
+    let ltimes: Vec<f64> = lrows.iter().map(|r| t_of(r, lt)).collect();
+    assert_eq!(replayed["samples"].as_u64(), Some(lrows.len() as u64), "{replayed}");
     let mut driven = 0;
     for r in &rows {
-        let k = index(r, ct);
-        let l = &lrows[k];
-        assert_eq!(index(l, lt), k, "loop.csv row {k}: t {}", l[lt]);
+        let t = t_of(r, ct);
+        // The loop's sample at the recorded time (both count time per period from 0).
+        let k = ltimes.partition_point(|&lt| lt < t - 0.25 / hz);
+        let l = lrows.get(k).unwrap_or_else(|| panic!("loop.csv ends before t = {t}"));
+        assert!((ltimes[k] - t).abs() < 0.25 / hz, "recorded t {t}: the loop has a sample at {}", ltimes[k]);
         let est: f32 = r[ce].parse().expect("torque_est");
         let again: f32 = l[le].parse().expect("loop torque_est");
-        assert_eq!(est.to_bits(), again.to_bits(), "sample {k}: recorded {est}, loop {again}");
+        assert_eq!(est.to_bits(), again.to_bits(), "t = {t}: recorded {est}, loop {again}");
         let tru: f32 = r[ctrue].parse().expect("torque");
-        assert_eq!(tru.to_bits(), l[ltrue].parse::<f32>().expect("loop torque").to_bits(), "sample {k}: true torque");
+        assert_eq!(tru.to_bits(), l[ltrue].parse::<f32>().expect("loop torque").to_bits(), "t = {t}: true torque");
         if r[cr].parse::<f64>().expect("reference") > 1.0 && est > 1.0 {
             driven += 1;
         }

@@ -71,7 +71,8 @@ pub struct LoopArgs {
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Control-step rate, Hz.
-    /// (default 10 000 for the scenarios; with `--replay`, the board's rate, 20 000).
+    /// (default 10 000 for the scenarios; with `--replay`, the rate the board runs the page's
+    /// model at, `firmware::runner`, and only that).
     #[arg(long)]
     pub control_hz: Option<f64>,
     /// Duration of the multisine run, s (default 20; the other scenarios have fixed
@@ -149,27 +150,26 @@ fn replay(a: &LoopArgs, clutch: &ClutchParams) -> anyhow::Result<()> {
     )
     .with_context(|| format!("--replay {}", journal.display()))?;
     let file = ParamsFile::read(params)?;
-    // The board's rate unless told otherwise: the page must be the one the board loaded.
-    let control_hz = a.control_hz.unwrap_or(f64::from(config_page::CONTROL_HZ));
-    let control = config_page::default_control(control_hz as f32)?;
+    // The rate the board runs the page's model at (the page must be the one it loaded).
+    let (control_hz, control) = config_page::firmware_control(&file.model, a.control_hz.map(|hz| hz as f32))?;
     let page = config_page::firmware_image(&file, params, control)?;
     let fault = a.fault.as_deref().map(super::virtual_board::parse_fault).transpose()?;
     if !(duration.is_finite() && duration > 0.0) {
         anyhow::bail!("--duration {duration}: expected a positive number of seconds");
     }
-    let samples = (duration * control_hz).round();
+    // At most this many samples: the board boots at the fastest rate.
+    let samples = (duration * f64::from(config_page::CONTROL_HZ.max(control_hz))).round();
     if !(1.0..=MAX_REPLAY_SAMPLES).contains(&samples) {
         anyhow::bail!(
-            "--duration {duration} s at {control_hz} Hz: {samples} samples; a replay runs 1 to {MAX_REPLAY_SAMPLES} (3 min at 20 kHz)"
+            "--duration {duration} s: up to {samples} samples; a replay runs 1 to {MAX_REPLAY_SAMPLES} (3 min at 20 kHz)"
         );
     }
-    let samples = samples as usize;
-    let rows = replay(clutch, a.seed, fault, &events, &page, samples)
+    let rows = replay(clutch, a.seed, fault, &events, &page, duration)
         .with_context(|| format!("--replay {}", journal.display()))?;
     hil_sim::io::output::write(trace, csv(&rows))?;
     if a.json {
         return super::print_json(&json!({
-            "replay": journal, "samples": rows.len(), "control_hz": control_hz, "page_crc": format!("{:#010x}", page.crc()), "trace": trace,
+            "replay": journal, "samples": rows.len(), "control_hz": f64::from(control_hz), "page_crc": format!("{:#010x}", page.crc()), "trace": trace,
         }));
     }
     super::emit(&format!(

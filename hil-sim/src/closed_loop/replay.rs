@@ -93,15 +93,16 @@ pub struct Row {
     pub fault: u8,
 }
 
-/// Replay `events` for `samples` samples on the clutch `clutch` (noise seed `seed`, `fault`
-/// scheduled), `page` swapped in at the journal's `page` event.
+/// Replay `events` for `duration` simulated seconds on the clutch `clutch` (noise seed
+/// `seed`, `fault` scheduled), `page` swapped in at the journal's `page` event (at its own
+/// control rate from then on, as the board's repetition counter does).
 pub fn replay(
     clutch: &ClutchParams,
     seed: u64,
     fault: Option<Schedule>,
     events: &[Event],
     page: &ConfigImage,
-    samples: usize,
+    duration: f64,
 ) -> Result<Vec<Row>, ReplayError> {
     let boot = firmware::bringup::default_image()?;
     let (lp, mut cfg): (Loop, ValidatedConfig) = runnable(&boot)?;
@@ -109,9 +110,11 @@ pub fn replay(
     let mut rig = Rig::new(clutch, &cfg, seed, fault);
     let mut cmd = Command { reference: 0.0, enable: false, reset: false };
     let mut reference = 0.0f32;
-    let mut out = Vec::with_capacity(samples);
+    let mut out = Vec::new();
     let mut ev = events.iter().peekable();
-    for k in 0..samples {
+    // Every sample that starts before `duration` (half a step of round-off allowed).
+    while rig.time() + 0.5 * rig.dt() < duration {
+        let k = rig.samples();
         cmd.reset = false;
         while let Some(e) = ev.next_if(|e| e.k <= k) {
             match e.applied {
@@ -184,7 +187,7 @@ mod tests {
     fn a_journal_of_another_page_is_refused() {
         let page = firmware::bringup::default_image().expect("page");
         let ev = [Event { k: 2, applied: Applied::Page(page.crc() ^ 1) }];
-        let r = replay(&ClutchParams::default(), 1, None, &ev, &page, 5);
+        let r = replay(&ClutchParams::default(), 1, None, &ev, &page, 5.0 / 20_000.0);
         assert!(matches!(r, Err(ReplayError::OtherPage { k: 2, .. })), "{r:?}");
     }
 
@@ -192,7 +195,7 @@ mod tests {
     fn replay_applies_the_reference_from_its_sample_on() {
         let page = firmware::bringup::default_image().expect("page");
         let ev = parse_journal("3 ref 4.5\n").expect("journal");
-        let rows = replay(&ClutchParams::default(), 1, None, &ev, &page, 6).expect("replay");
+        let rows = replay(&ClutchParams::default(), 1, None, &ev, &page, 6.0 / 20_000.0).expect("replay");
         let refs: Vec<f32> = rows.iter().map(|r| r.reference).collect();
         assert_eq!(refs, [0.0, 0.0, 0.0, 4.5, 4.5, 4.5]);
     }
