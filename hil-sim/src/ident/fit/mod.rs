@@ -525,10 +525,13 @@ fn identify(
                     let swarm = SwarmOptions { seed, ..opts.swarm };
                     let search = |swarm| global::global_search(id, sp, (&win, &full), opts, swarm, &polished_start);
                     let r = search(swarm).and_then(|first| match first {
-                        (Some(best), e) => Ok((Some(best), e)),
+                        (Some(best), e, _) => Ok((Some(best), e)),
                         // A box where the small swarm found nothing valid (a start that is not a
-                        // published set, a narrow valid region) gets a wider search before giving up.
-                        (None, e) => search(SwarmOptions::wide(seed)).map(|(b, more)| (b, e + more)),
+                        // published set, a narrow valid region) gets a wider search before giving
+                        // up; not one where it did and the polished points are not valid on the
+                        // whole training part (a wider swarm on the same window finds the same).
+                        (None, e, true) => Ok((None, e)),
+                        (None, e, false) => search(SwarmOptions::wide(seed)).map(|(b, more, _)| (b, e + more)),
                     });
                     match r {
                         Ok((b, e)) => {
