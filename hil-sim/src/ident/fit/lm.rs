@@ -4,7 +4,9 @@
 //! Each free parameter's box position `s ∈ [0, 1]` is written `s = (1 + sin θ)/2` with `θ`
 //! unconstrained (the MINUIT transform), so every trial point the solver proposes is inside
 //! the box. The Jacobian is a forward difference in `θ` through the f32 core, its columns
-//! computed in parallel.
+//! computed in parallel; the solver is handed the problem reduced to one row per parameter
+//! ([`crate::numerics::reduce`]: the same steps up to round-off, without a QR factorisation of
+//! the rows × parameters Jacobian at every iteration).
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::storage::Owned;
@@ -40,8 +42,6 @@ struct Problem<'a, 'b> {
     /// Jacobians computed so far, and the most allowed (each costs one run per free parameter).
     jacobians: std::sync::atomic::AtomicUsize,
     max_jacobians: usize,
-    /// Hand the solver the problem reduced to `n + 1` rows ([`reduce`]).
-    reduce: bool,
 }
 
 fn unit_of_theta(theta: &[f64]) -> Vec<f64> {
@@ -74,7 +74,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
 
     fn residuals(&self) -> Option<DVector<f64>> {
         let r = self.residuals.clone().unwrap_or_else(|| self.penalty());
-        Some(if self.reduce { reduce::reduced_residuals(r.as_slice(), self.theta.len()) } else { r })
+        Some(reduce::reduced_residuals(r.as_slice(), self.theta.len()))
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
@@ -105,7 +105,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
                 jac.column_mut(j).copy_from_slice(&col);
             }
         }
-        Some(if self.reduce { reduce::reduced(&jac, base.as_slice()) } else { jac })
+        Some(reduce::reduced(&jac, base.as_slice()))
     }
 }
 
@@ -114,17 +114,6 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
 /// evaluations. Stops earlier when the relative decrease of the cost or the step falls
 /// below 1e-7.
 pub fn minimize(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> LocalFit {
-    minimize_with(obj, start, max_iterations, false)
-}
-
-/// [`minimize`] with the solver's problem reduced to one row per parameter
-/// ([`crate::numerics::reduce`]): the same steps up to round-off, for many rows and many
-/// parameters (the networks), where factoring the full Jacobian is most of the cost.
-pub fn minimize_reduced(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> LocalFit {
-    minimize_with(obj, start, max_iterations, true)
-}
-
-fn minimize_with(obj: &Objective<'_>, start: &[f64], max_iterations: usize, reduce: bool) -> LocalFit {
     let theta0: Vec<f64> = obj.to_unit(start).iter().map(|s| (2.0 * s - 1.0).clamp(-1.0, 1.0).asin()).collect();
     let n = theta0.len();
     if n == 0 {
@@ -142,7 +131,6 @@ fn minimize_with(obj: &Objective<'_>, start: &[f64], max_iterations: usize, redu
         evaluations: 0,
         jacobians: std::sync::atomic::AtomicUsize::new(0),
         max_jacobians: max_iterations.max(1),
-        reduce,
     };
     problem.set_params(&DVector::from_vec(theta0));
     let patience = (10 * max_iterations / (n + 1)).max(1);
