@@ -9,8 +9,9 @@
 //! `Jᵀr` and `‖r‖`, so the problem with `m` rows can be handed to it as one with `n + 1`:
 //! the residual vector `‖r‖·e₁` and the matrix `A` (`(n + 1) × n`) of the Cholesky factor of
 //! `[r J]ᵀ[r J]` without its first column, which has `AᵀA = JᵀJ`, `Aᵀ(‖r‖·e₁) = Jᵀr`. The
-//! Gram matrix is one matrix product (blocked, vectorised); a direction the columns do not
-//! excite (a zero column, a numerically dependent one) gets a zero row.
+//! Gram matrix is column dot products in a fixed order (vectorised, machine-independent, so
+//! a fit gives the same numbers everywhere); a direction the columns do not excite (a zero
+//! column, a numerically dependent one) gets a zero row.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -25,11 +26,20 @@ pub fn reduced(j: &DMatrix<f64>, r: &[f64]) -> DMatrix<f64> {
     let mut m = DMatrix::<f64>::zeros(j.nrows(), n + 1);
     m.column_mut(0).copy_from_slice(r);
     m.columns_mut(1, n).copy_from(j);
-    let g = m.transpose() * &m;
+    let mut g = DMatrix::<f64>::zeros(n + 1, n + 1);
+    for a in 0..=n {
+        for b in a..=n {
+            let v = dot(m.column(a).as_slice(), m.column(b).as_slice());
+            g[(a, b)] = v;
+            g[(b, a)] = v;
+        }
+    }
     let mut u = DMatrix::<f64>::zeros(n + 1, n + 1);
     for k in 0..=n {
         let d = g[(k, k)] - (0..k).map(|i| u[(i, k)] * u[(i, k)]).sum::<f64>();
-        if !(d > DEPENDENT * g[(k, k)]) || !d.is_finite() {
+        // Also a NaN pivot: the row stays zero.
+        let independent = d > DEPENDENT * g[(k, k)] && d.is_finite();
+        if !independent {
             continue;
         }
         let piv = d.sqrt();
@@ -39,6 +49,24 @@ pub fn reduced(j: &DMatrix<f64>, r: &[f64]) -> DMatrix<f64> {
         }
     }
     u.columns(1, n).into_owned()
+}
+
+/// `Σ aᵢ·bᵢ` in eight independent partial sums (vectorised, and the same on every machine:
+/// the order of the additions is fixed).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    let mut acc = [0.0f64; 8];
+    for (x, y) in ca.zip(cb) {
+        for k in 0..8 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    let mut s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
 }
 
 /// The residual vector that goes with [`reduced`]: `‖r‖·e₁` (`n + 1` entries).
