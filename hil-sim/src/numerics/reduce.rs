@@ -3,8 +3,7 @@
 //!
 //! The `levenberg-marquardt` crate factors the Jacobian it is given (a pivoted Householder
 //! QR, column by column): for a network trained on thousands of rows that factorisation, not
-//! the network, is most of the fit, and for the global searches' final runs on a whole
-//! recording it is a tenth or so. Every quantity the solver computes (the scaled gradient
+//! the network, is most of the fit. Every quantity the solver computes (the scaled gradient
 //! `Jᵀr`, the column norms, `‖J·p‖`, the step) depends on `J` and `r` only through `JᵀJ`,
 //! `Jᵀr` and `‖r‖`, so the problem with `m` rows can be handed to it as one with `n + 1`:
 //! the residual vector `‖r‖·e₁` and the matrix `A` (`(n + 1) × n`) of the Cholesky factor of

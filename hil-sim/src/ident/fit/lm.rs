@@ -4,9 +4,8 @@
 //! Each free parameter's box position `s ∈ [0, 1]` is written `s = (1 + sin θ)/2` with `θ`
 //! unconstrained (the MINUIT transform), so every trial point the solver proposes is inside
 //! the box. The Jacobian is a forward difference in `θ` through the f32 core, its columns
-//! computed in parallel; the solver is handed the problem reduced to one row per parameter
-//! ([`crate::numerics::reduce`]: the same steps up to round-off, without a QR factorisation of
-//! the rows × parameters Jacobian at every iteration).
+//! computed in parallel. For the networks ([`minimize_reduced`]) the solver is handed the
+//! problem reduced to one row per parameter ([`crate::numerics::reduce`]).
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::storage::Owned;
@@ -42,6 +41,8 @@ struct Problem<'a, 'b> {
     /// Jacobians computed so far, and the most allowed (each costs one run per free parameter).
     jacobians: std::sync::atomic::AtomicUsize,
     max_jacobians: usize,
+    /// Hand the solver the problem reduced to `n + 1` rows ([`reduce`]).
+    reduce: bool,
 }
 
 fn unit_of_theta(theta: &[f64]) -> Vec<f64> {
@@ -74,7 +75,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
 
     fn residuals(&self) -> Option<DVector<f64>> {
         let r = self.residuals.clone().unwrap_or_else(|| self.penalty());
-        Some(reduce::reduced_residuals(r.as_slice(), self.theta.len()))
+        Some(if self.reduce { reduce::reduced_residuals(r.as_slice(), self.theta.len()) } else { r })
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
@@ -105,7 +106,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
                 jac.column_mut(j).copy_from_slice(&col);
             }
         }
-        Some(reduce::reduced(&jac, base.as_slice()))
+        Some(if self.reduce { reduce::reduced(&jac, base.as_slice()) } else { jac })
     }
 }
 
@@ -114,6 +115,20 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
 /// evaluations. Stops earlier when the relative decrease of the cost or the step falls
 /// below 1e-7.
 pub fn minimize(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> LocalFit {
+    minimize_with(obj, start, max_iterations, false)
+}
+
+/// [`minimize`] with the solver's problem reduced to one row per parameter
+/// ([`crate::numerics::reduce`]): the same steps up to round-off, for many rows and many
+/// parameters (the Hammerstein–Wiener network), where factoring the full Jacobian is a large
+/// part of the cost. The global searches keep the crate's factorisation: there it is a tenth
+/// of the cost or less, and a change of round-off moves which restarts agree (Spencer's
+/// model on `ranran_50.csv` then needed a fourth start: slower, not faster).
+pub fn minimize_reduced(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> LocalFit {
+    minimize_with(obj, start, max_iterations, true)
+}
+
+fn minimize_with(obj: &Objective<'_>, start: &[f64], max_iterations: usize, reduce: bool) -> LocalFit {
     let theta0: Vec<f64> = obj.to_unit(start).iter().map(|s| (2.0 * s - 1.0).clamp(-1.0, 1.0).asin()).collect();
     let n = theta0.len();
     if n == 0 {
@@ -131,6 +146,7 @@ pub fn minimize(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> Lo
         evaluations: 0,
         jacobians: std::sync::atomic::AtomicUsize::new(0),
         max_jacobians: max_iterations.max(1),
+        reduce,
     };
     problem.set_params(&DVector::from_vec(theta0));
     let patience = (10 * max_iterations / (n + 1)).max(1);
