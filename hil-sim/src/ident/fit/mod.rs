@@ -529,7 +529,8 @@ fn identify(
                         // A box where the small swarm found nothing valid (a start that is not a
                         // published set, a narrow valid region) gets a wider search before giving
                         // up; not one where it did and the polished points are not valid on the
-                        // whole training part (a wider swarm on the same window finds the same).
+                        // whole training part (the wider swarm searches the same window: GPI on
+                        // `ranran_50.csv` ran it seven times for nothing valid).
                         (None, e, true) => Ok((None, e)),
                         (None, e, false) => search(SwarmOptions::wide(seed)).map(|(b, more, _)| (b, e + more)),
                     });
