@@ -7,10 +7,18 @@ use nalgebra::{DMatrix, DVector};
 
 /// Add one row `a` with target `b` to the lower triangle of `gram` and to `atb`.
 pub fn accumulate(gram: &mut DMatrix<f64>, atb: &mut DVector<f64>, a: &[f64], b: f64) {
-    for r in 0..atb.len() {
-        atb[r] += a[r] * b;
-        for c in 0..=r {
-            gram[(r, c)] += a[r] * a[c];
+    let n = atb.len();
+    let a = &a[..n];
+    for (t, ar) in atb.iter_mut().zip(a) {
+        *t += ar * b;
+    }
+    // Column by column (contiguous in the column-major storage); every entry gets the same
+    // one product per row as entry by entry would.
+    for (c, &ac) in a.iter().enumerate() {
+        let mut col = gram.column_mut(c);
+        let Some(col) = col.as_mut_slice().get_mut(c..n) else { continue };
+        for (g, ar) in col.iter_mut().zip(&a[c..]) {
+            *g += ar * ac;
         }
     }
 }

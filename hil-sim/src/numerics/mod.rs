@@ -7,6 +7,7 @@ pub mod lstsq;
 pub mod metrics;
 pub mod nnls;
 pub mod number;
+pub mod reduce;
 pub mod stats;
 pub mod units;
 

@@ -126,7 +126,8 @@ pub fn search(obj: &Objective<'_>, opts: SwarmOptions) -> Result<Vec<Candidate>,
 /// The global phase of [`Strategy::Global`]: swarm on the window, then every candidate and
 /// the papers' start polished there (the start once per fit: `polished_start` keeps it for
 /// the other starts of [`super::restarts::until_agree`]). Returns the candidate with the lowest cost
-/// on the whole training part (`None` when none is valid) and the evaluations spent.
+/// on the whole training part (`None` when none is valid), the evaluations spent, and whether
+/// the swarm found any valid point on the window.
 pub(super) fn global_search(
     id: &str,
     sp: &ModelSpec,
@@ -134,8 +135,9 @@ pub(super) fn global_search(
     opts: &FitOptions,
     swarm: SwarmOptions,
     polished_start: &std::sync::OnceLock<lm::LocalFit>,
-) -> Result<(Option<lm::LocalFit>, usize), FitError> {
+) -> Result<(Option<lm::LocalFit>, usize, bool), FitError> {
     let mut cands = search(win, swarm).map_err(|e| FitError::Swarm { model: id.to_owned(), reason: e.to_string() })?;
+    let found = !cands.is_empty();
     // The papers' starting values are always polished too: they are often in the
     // right basin already (Spencer's published set on the Dyke files is), and the
     // swarm offers the alternatives.
@@ -161,5 +163,5 @@ pub(super) fn global_search(
     let evals =
         swarm.particles * (swarm.iterations as usize + 1) + polished.iter().map(|r| r.evaluations).sum::<usize>();
     let best = polished.into_iter().filter(|r| r.cost.is_finite()).min_by(|a, b| a.cost.total_cmp(&b.cost));
-    Ok((best, evals))
+    Ok((best, evals, found))
 }

@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use rayon::prelude::*;
+use std::sync::Mutex;
 use thiserror::Error;
 
 use super::{fit, FitError, FitOptions, FitResult};
@@ -69,7 +69,9 @@ pub enum FitJobError {
 
 /// Fit each model in `ids` on `data`, one progress step per model; results in the order of `ids`.
 /// The models are fitted side by side (each fit is deterministic on its own, so the results
-/// are those of fitting them one after another); the first error in the order of `ids` is returned.
+/// are those of fitting them one after another), the longest searches started first so that
+/// no long fit is left to run alone at the end; the first error in the order of `ids` is
+/// returned.
 pub fn fit_many(
     data: &crate::ident::dataset::Dataset,
     ids: &[String],
@@ -77,17 +79,56 @@ pub fn fit_many(
     progress: &dyn Progress,
 ) -> Result<Vec<FitResult>, FitJobError> {
     progress.stage("fitting", ids.len() as u64);
-    let out: Vec<Result<FitResult, FitJobError>> = ids
-        .par_iter()
-        .map(|id| {
-            progress.message(id);
-            let r =
-                fit(id, data, opts).map_err(|source| FitJobError::Fit { model: id.clone(), source: Box::new(source) });
-            progress.advance(1);
-            r
+    let mut order: Vec<usize> = (0..ids.len()).collect();
+    let scales = data.scales();
+    order.sort_by_key(|&i| expected_cost(&ids[i], &scales, opts));
+    let slots: Vec<Mutex<Option<Result<FitResult, FitJobError>>>> = ids.iter().map(|_| Mutex::new(None)).collect();
+    // FIFO: the workers take the fits in `order`, each the next one when it is free.
+    rayon::scope_fifo(|s| {
+        for &i in &order {
+            let (Some(id), Some(slot)) = (ids.get(i), slots.get(i)) else { continue };
+            s.spawn_fifo(move |_| {
+                progress.message(id);
+                let r = fit(id, data, opts)
+                    .map_err(|source| FitJobError::Fit { model: id.clone(), source: Box::new(source) });
+                progress.advance(1);
+                if let Ok(mut slot) = slot.lock() {
+                    *slot = Some(r);
+                }
+            });
+        }
+    });
+    slots
+        .into_iter()
+        .zip(ids)
+        .map(|(slot, id)| {
+            slot.into_inner().ok().flatten().unwrap_or_else(|| {
+                Err(FitJobError::Fit { model: id.clone(), source: Box::new(FitError::UnknownModel(id.clone())) })
+            })
         })
-        .collect();
-    out.into_iter().collect()
+        .collect()
+}
+
+/// Rank of model `id`'s fit by its usual cost, longest first: the networks, the projected
+/// operator models, the global searches (more free parameters first), then the rest.
+fn expected_cost(
+    id: &str,
+    scales: &crate::models::search::Scales,
+    opts: &FitOptions,
+) -> (u8, std::cmp::Reverse<usize>) {
+    use crate::models::search::Strategy;
+    let Some(sp) = crate::models::host(id).and_then(|h| h.spec(scales, opts.rate)) else {
+        return (u8::MAX, std::cmp::Reverse(0));
+    };
+    let rank = match sp.strategy {
+        Strategy::Network => 0,
+        Strategy::Projected => 1,
+        Strategy::Global => 2,
+        Strategy::Local => 3,
+        Strategy::Operator => 4,
+        Strategy::Linear => 5,
+    };
+    (rank, std::cmp::Reverse(sp.free().len()))
 }
 
 /// Run the job: prepare the recording, fit, save.

@@ -4,7 +4,8 @@
 //! Each free parameter's box position `s ∈ [0, 1]` is written `s = (1 + sin θ)/2` with `θ`
 //! unconstrained (the MINUIT transform), so every trial point the solver proposes is inside
 //! the box. The Jacobian is a forward difference in `θ` through the f32 core, its columns
-//! computed in parallel.
+//! computed in parallel. For the networks ([`minimize_reduced`]) the solver is handed the
+//! problem reduced to one row per parameter ([`crate::numerics::reduce`]).
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::storage::Owned;
@@ -13,6 +14,7 @@ use rayon::prelude::*;
 use std::sync::atomic::Ordering::Relaxed;
 
 use super::objective::Objective;
+use crate::numerics::reduce;
 
 /// Step of the forward difference in θ. The f32 core resolves about 1e-7 of the output, so
 /// a step near the square root of that keeps round-off and truncation error balanced.
@@ -39,6 +41,8 @@ struct Problem<'a, 'b> {
     /// Jacobians computed so far, and the most allowed (each costs one run per free parameter).
     jacobians: std::sync::atomic::AtomicUsize,
     max_jacobians: usize,
+    /// Hand the solver the problem reduced to `n + 1` rows ([`reduce`]).
+    reduce: bool,
 }
 
 fn unit_of_theta(theta: &[f64]) -> Vec<f64> {
@@ -70,7 +74,8 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
     }
 
     fn residuals(&self) -> Option<DVector<f64>> {
-        Some(self.residuals.clone().unwrap_or_else(|| self.penalty()))
+        let r = self.residuals.clone().unwrap_or_else(|| self.penalty());
+        Some(if self.reduce { reduce::reduced_residuals(r.as_slice(), self.theta.len()) } else { r })
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
@@ -101,7 +106,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
                 jac.column_mut(j).copy_from_slice(&col);
             }
         }
-        Some(jac)
+        Some(if self.reduce { reduce::reduced(&jac, base.as_slice()) } else { jac })
     }
 }
 
@@ -110,6 +115,20 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_, '_> {
 /// evaluations. Stops earlier when the relative decrease of the cost or the step falls
 /// below 1e-7.
 pub fn minimize(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> LocalFit {
+    minimize_with(obj, start, max_iterations, false)
+}
+
+/// [`minimize`] with the solver's problem reduced to one row per parameter
+/// ([`crate::numerics::reduce`]): the same steps up to round-off, for many rows and many
+/// parameters (the Hammerstein–Wiener network), where factoring the full Jacobian is a large
+/// part of the cost. The global searches keep the crate's factorisation: there it is a tenth
+/// of the cost or less, and a change of round-off moves which restarts agree (Spencer's
+/// model on `ranran_50.csv` then needed a fourth start: slower, not faster).
+pub fn minimize_reduced(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> LocalFit {
+    minimize_with(obj, start, max_iterations, true)
+}
+
+fn minimize_with(obj: &Objective<'_>, start: &[f64], max_iterations: usize, reduce: bool) -> LocalFit {
     let theta0: Vec<f64> = obj.to_unit(start).iter().map(|s| (2.0 * s - 1.0).clamp(-1.0, 1.0).asin()).collect();
     let n = theta0.len();
     if n == 0 {
@@ -127,6 +146,7 @@ pub fn minimize(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> Lo
         evaluations: 0,
         jacobians: std::sync::atomic::AtomicUsize::new(0),
         max_jacobians: max_iterations.max(1),
+        reduce,
     };
     problem.set_params(&DVector::from_vec(theta0));
     let patience = (10 * max_iterations / (n + 1)).max(1);

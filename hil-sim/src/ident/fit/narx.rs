@@ -142,11 +142,11 @@ pub fn train(
     if !win.cost(&start).is_finite() {
         return None;
     }
-    let a = lm::minimize(&win, &start, iterations);
+    let a = lm::minimize_reduced(&win, &start, iterations);
     let long: Vec<usize> = rows.iter().copied().filter(|&i| i < 3 * window).collect();
     let long = if long.len() < 200 { sub.clone() } else { subsample(&long) };
     let full = Objective::new(sim.as_ref(), &sp, kin, y, &long, ysd);
-    let b = lm::minimize(&full, &a.params, (iterations / 4).max(1));
+    let b = lm::minimize_reduced(&full, &a.params, (iterations / 4).max(1));
     // The start (a linear FIR / identity network) is itself a valid model: keep it when the
     // trained network does not beat it over the whole training part (a recursion trained on
     // the first stretch can still drift away later on: `ransim_u.csv` did).

@@ -9,6 +9,9 @@ use super::simulate::Simulator;
 use crate::models::alignment::{shift_kin_runs, MAX_DELAY_SAMPLES};
 use crate::models::search::ModelSpec;
 
+/// Shifted kinematics kept ([`Objective::shifted_by`]).
+const SHIFT_CACHE: usize = 4;
+
 /// Kinematics shifted by an (input, command) delay pair, in samples.
 type ShiftedKin = ((f64, f64), Arc<Vec<Kin>>);
 
@@ -32,9 +35,9 @@ pub struct Objective<'a> {
     pub scale: f64,
     /// Indices of the free parameters.
     pub free: Vec<usize>,
-    /// The kinematics shifted by the delays last asked for: a Jacobian's columns for the
-    /// model's own parameters all share one pair of delays.
-    shifted: Mutex<Option<ShiftedKin>>,
+    /// The kinematics shifted by the delays last asked for (the latest first): a Jacobian's
+    /// columns for the model's own parameters all share one pair of delays.
+    shifted: Mutex<Vec<ShiftedKin>>,
 }
 
 impl<'a> Objective<'a> {
@@ -57,7 +60,7 @@ impl<'a> Objective<'a> {
             rows,
             scale: scale.max(1e-300),
             free: spec.free(),
-            shifted: Mutex::new(None),
+            shifted: Mutex::new(Vec::new()),
         }
     }
 
@@ -88,28 +91,47 @@ impl<'a> Objective<'a> {
         self.free.iter().filter_map(|&j| Some(self.spec.params.get(j)?.to_unit(*p.get(j)?))).collect()
     }
 
-    /// Scaled residuals at `p`, `None` when the model rejects `p` or diverges.
-    pub fn residuals(&self, p: &[f64]) -> Option<Vec<f64>> {
-        let mut out = vec![0.0; self.end];
-        let (d, d_u) = self.delays(p);
-        let ok = if d == 0.0 && d_u == 0.0 {
-            self.sim.run(self.model_params(p), self.kin.get(..self.end)?, &mut out)
-        } else {
-            let shifted = self.shifted_by(d, d_u);
-            self.sim.run(self.model_params(p), shifted.get(..self.end)?, &mut out)
-        };
-        if !ok {
-            return None;
+    /// Run the model at `p` over the samples up to the last row and hand its output to `with`
+    /// (`None` when the model rejects `p` or diverges). The output buffer is the thread's own,
+    /// reused from one run to the next.
+    fn simulate<T>(&self, p: &[f64], with: impl FnOnce(&[f64]) -> Option<T>) -> Option<T> {
+        thread_local! {
+            static OUT: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
         }
-        let inv = 1.0 / self.scale;
-        self.rows.iter().map(|&i| Some((out.get(i)? - self.y.get(i)?) * inv)).collect()
+        let run = |out: &mut Vec<f64>| -> Option<T> {
+            out.clear();
+            out.resize(self.end, 0.0);
+            let (d, d_u) = self.delays(p);
+            let ok = if d == 0.0 && d_u == 0.0 {
+                self.sim.run(self.model_params(p), self.kin.get(..self.end)?, out)
+            } else {
+                let shifted = self.shifted_by(d, d_u);
+                self.sim.run(self.model_params(p), shifted.get(..self.end)?, out)
+            };
+            if ok {
+                with(out)
+            } else {
+                None
+            }
+        };
+        OUT.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut out) => run(&mut out),
+            Err(_) => run(&mut Vec::new()),
+        })
     }
 
-    /// The kinematics shifted by `(d, d_u)` samples, from the cache when the delays are the
-    /// ones last asked for.
+    /// Scaled residuals at `p`, `None` when the model rejects `p` or diverges.
+    pub fn residuals(&self, p: &[f64]) -> Option<Vec<f64>> {
+        let inv = 1.0 / self.scale;
+        self.simulate(p, |out| self.rows.iter().map(|&i| Some((out.get(i)? - self.y.get(i)?) * inv)).collect())
+    }
+
+    /// The kinematics shifted by `(d, d_u)` samples, from the cache when the delays are
+    /// among the last few asked for (a Jacobian's columns ask for the point's delays and
+    /// for each delay stepped, concurrently).
     fn shifted_by(&self, d: f64, d_u: f64) -> Arc<Vec<Kin>> {
         if let Ok(cache) = self.shifted.lock() {
-            if let Some((_, kin)) = cache.as_ref().filter(|(key, _)| *key == (d, d_u)) {
+            if let Some((_, kin)) = cache.iter().find(|(key, _)| *key == (d, d_u)) {
                 return Arc::clone(kin);
             }
         }
@@ -117,15 +139,38 @@ impl<'a> Objective<'a> {
         shift_kin_runs(self.kin, d, d_u, self.sim.run_starts(), &mut shifted);
         let shifted = Arc::new(shifted);
         if let Ok(mut cache) = self.shifted.lock() {
-            *cache = Some(((d, d_u), Arc::clone(&shifted)));
+            if !cache.iter().any(|(key, _)| *key == (d, d_u)) {
+                cache.insert(0, ((d, d_u), Arc::clone(&shifted)));
+                cache.truncate(SHIFT_CACHE);
+            }
         }
         shifted
     }
 
-    /// Mean squared scaled residual (∞ when invalid).
+    /// Mean squared scaled residual (∞ when invalid): [`crate::numerics::stats::mean_square`]
+    /// of [`Objective::residuals`], summed as it sums them, without the residual vector.
     pub fn cost(&self, p: &[f64]) -> f64 {
-        match self.residuals(p) {
-            Some(r) if !r.is_empty() => crate::numerics::stats::mean_square(&r),
+        let inv = 1.0 / self.scale;
+        let sum = self.simulate(p, |out| {
+            let mut bad = false;
+            let s = self
+                .rows
+                .iter()
+                .map(|&i| match (out.get(i), self.y.get(i)) {
+                    (Some(o), Some(y)) => {
+                        let r = (o - y) * inv;
+                        r * r
+                    }
+                    _ => {
+                        bad = true;
+                        0.0
+                    }
+                })
+                .sum::<f64>();
+            (!bad).then_some(s)
+        });
+        match sum {
+            Some(s) if !self.rows.is_empty() => s / self.rows.len() as f64,
             _ => f64::INFINITY,
         }
     }

@@ -43,6 +43,7 @@ use rand::{Rng, SeedableRng};
 use rayon::prelude::*;
 
 use super::lm::PENALTY;
+use crate::numerics::reduce;
 
 mod twin;
 
@@ -91,8 +92,14 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
         self.x.clone()
     }
 
+    // The solver sees the problem reduced to `n + 1` rows ([`reduce`]): the same steps,
+    // without a factorisation of the rows × weights Jacobian per iteration.
     fn residuals(&self) -> Option<DVector<f64>> {
-        Some(self.res.clone().unwrap_or_else(|| DVector::from_element(self.rows.len(), PENALTY)))
+        let n = self.cols.len();
+        Some(match &self.res {
+            Some(r) => reduce::reduced_residuals(r.as_slice(), n),
+            None => reduce::reduced_residuals(&vec![PENALTY; self.rows.len()], n),
+        })
     }
 
     fn jacobian(&self) -> Option<DMatrix<f64>> {
@@ -103,7 +110,7 @@ impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
         let mut j = DMatrix::zeros(self.rows.len(), self.cols.len());
         let th = self.theta(self.x.as_slice());
         self.twin.run(&th, self.rows, self.cols, Some(&mut j))?;
-        Some(j)
+        Some(reduce::reduced(&j, self.res.as_ref()?.as_slice()))
     }
 }
 

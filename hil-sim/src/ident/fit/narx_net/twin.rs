@@ -53,37 +53,63 @@ pub struct Twin {
 /// One evaluation of eq. 18–19 at regressors `r` (normalised): the unit activations into
 /// `act`; returns the unclamped output and `∂f/∂ŷ(t−1)`.
 pub(super) fn eval(sh: Shape, th: &[f64], r: &[f64; 7], act: &mut [f64]) -> (f64, f64) {
-    let mut y = th[sh.c()];
-    let mut dfdy = th[0];
-    for k in 0..7 {
-        y += th[k] * r[k];
+    let (lin, w, b, a, c) = blocks(sh, th);
+    let act = &mut act[..sh.h];
+    let mut y = c;
+    let mut dfdy = lin[0];
+    for (l, rk) in lin.iter().zip(r) {
+        y += l * rk;
     }
-    for j in 0..sh.h {
-        let mut s = th[sh.b(j)];
-        for k in 0..7 {
-            s += th[sh.w(j, k)] * r[k];
+    // The units' sums, then their sigmoids, then the output's sums (each in the order of one
+    // unit after the other, as before): the units' independent chains are not serialised
+    // behind each unit's `exp`.
+    for ((wj, bj), s) in w.chunks_exact(7).zip(b).zip(act.iter_mut()) {
+        let mut acc = *bj;
+        for (wk, rk) in wj.iter().zip(r) {
+            acc += wk * rk;
         }
-        let sg = sigmoid(s);
-        act[j] = sg;
-        y += th[sh.a(j)] * sg;
-        dfdy += th[sh.a(j)] * sg * (1.0 - sg) * th[sh.w(j, 0)];
+        *s = acc;
+    }
+    for s in act.iter_mut() {
+        *s = sigmoid(*s);
+    }
+    for ((aj, &sg), wj) in a.iter().zip(act.iter()).zip(w.chunks_exact(7)) {
+        y += aj * sg;
+        dfdy += aj * sg * (1.0 - sg) * wj[0];
     }
     (y, dfdy)
 }
 
+/// The free block `th` split as [`Shape`] lays it out: `lin[7], hid_w[7·h], hid_b[h],
+/// out_a[h], offset` (one slice split instead of an index check per weight).
+fn blocks(sh: Shape, th: &[f64]) -> (&[f64; 7], &[f64], &[f64], &[f64], f64) {
+    let h = sh.h;
+    let (lin, rest) = th.split_at(7);
+    let (w, rest) = rest.split_at(7 * h);
+    let (b, rest) = rest.split_at(h);
+    let (a, rest) = rest.split_at(h);
+    let lin: &[f64; 7] = lin.try_into().unwrap_or(&[0.0; 7]);
+    (lin, w, b, a, rest[0])
+}
+
 /// `∂f/∂θ` at regressors `r` (activations from [`eval`]), into `g`.
 pub(super) fn direct(sh: Shape, th: &[f64], r: &[f64; 7], act: &[f64], g: &mut [f64]) {
-    g[..7].copy_from_slice(r);
-    for j in 0..sh.h {
-        let sg = act[j];
-        let ad = th[sh.a(j)] * sg * (1.0 - sg);
-        for k in 0..7 {
-            g[sh.w(j, k)] = ad * r[k];
+    let h = sh.h;
+    let (_, _, _, a, _) = blocks(sh, th);
+    let (g_lin, rest) = g.split_at_mut(7);
+    let (g_w, rest) = rest.split_at_mut(7 * h);
+    let (g_b, rest) = rest.split_at_mut(h);
+    let (g_a, rest) = rest.split_at_mut(h);
+    g_lin.copy_from_slice(r);
+    for ((((gwj, gbj), gaj), aj), &sg) in g_w.chunks_exact_mut(7).zip(g_b).zip(g_a).zip(a).zip(&act[..h]) {
+        let ad = aj * sg * (1.0 - sg);
+        for (gk, rk) in gwj.iter_mut().zip(r) {
+            *gk = ad * rk;
         }
-        g[sh.b(j)] = ad;
-        g[sh.a(j)] = sg;
+        *gbj = ad;
+        *gaj = sg;
     }
-    g[sh.c()] = 1.0;
+    rest[0] = 1.0;
 }
 
 impl Twin {

@@ -1,0 +1,96 @@
+//! A tall least-squares step reduced to a square one, for Levenberg–Marquardt on long
+//! recordings.
+//!
+//! The `levenberg-marquardt` crate factors the Jacobian it is given (a pivoted Householder
+//! QR, column by column): for a network trained on thousands of rows that factorisation, not
+//! the network, is most of the fit. Every quantity the solver computes (the scaled gradient
+//! `Jᵀr`, the column norms, `‖J·p‖`, the step) depends on `J` and `r` only through `JᵀJ`,
+//! `Jᵀr` and `‖r‖`, so the problem with `m` rows can be handed to it as one with `n + 1`:
+//! the residual vector `‖r‖·e₁` and the matrix `A` (`(n + 1) × n`) of the Cholesky factor of
+//! `[r J]ᵀ[r J]` without its first column, which has `AᵀA = JᵀJ`, `Aᵀ(‖r‖·e₁) = Jᵀr`. The
+//! Gram matrix is column dot products in a fixed order (vectorised, machine-independent, so
+//! a fit gives the same numbers everywhere); a direction the columns do not excite (a zero
+//! column, a numerically dependent one) gets a zero row.
+
+use nalgebra::{DMatrix, DVector};
+
+/// Relative pivot below which a direction counts as dependent on the earlier ones.
+const DEPENDENT: f64 = 1e-13;
+
+/// `A` for Jacobian `j` (`m × n`) and residuals `r` (`m`): `(n + 1) × n` with `AᵀA = JᵀJ`
+/// and `A`'s first row `rᵀJ / ‖r‖` (so `Aᵀ(‖r‖·e₁) = Jᵀr`); rows of `A` below a dependent
+/// pivot are zero.
+pub fn reduced(j: &DMatrix<f64>, r: &[f64]) -> DMatrix<f64> {
+    let n = j.ncols();
+    let mut m = DMatrix::<f64>::zeros(j.nrows(), n + 1);
+    m.column_mut(0).copy_from_slice(r);
+    m.columns_mut(1, n).copy_from(j);
+    let mut g = DMatrix::<f64>::zeros(n + 1, n + 1);
+    for a in 0..=n {
+        for b in a..=n {
+            let v = dot(m.column(a).as_slice(), m.column(b).as_slice());
+            g[(a, b)] = v;
+            g[(b, a)] = v;
+        }
+    }
+    let mut u = DMatrix::<f64>::zeros(n + 1, n + 1);
+    for k in 0..=n {
+        let d = g[(k, k)] - (0..k).map(|i| u[(i, k)] * u[(i, k)]).sum::<f64>();
+        // Also a NaN pivot: the row stays zero.
+        let independent = d > DEPENDENT * g[(k, k)] && d.is_finite();
+        if !independent {
+            continue;
+        }
+        let piv = d.sqrt();
+        u[(k, k)] = piv;
+        for c in k + 1..=n {
+            u[(k, c)] = (g[(k, c)] - (0..k).map(|i| u[(i, k)] * u[(i, c)]).sum::<f64>()) / piv;
+        }
+    }
+    u.columns(1, n).into_owned()
+}
+
+/// `Σ aᵢ·bᵢ` in eight independent partial sums (vectorised, and the same on every machine:
+/// the order of the additions is fixed).
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    let mut acc = [0.0f64; 8];
+    for (x, y) in ca.zip(cb) {
+        for k in 0..8 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    let mut s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
+}
+
+/// The residual vector that goes with [`reduced`]: `‖r‖·e₁` (`n + 1` entries).
+pub fn reduced_residuals(r: &[f64], n: usize) -> DVector<f64> {
+    let mut v = DVector::zeros(n + 1);
+    v[0] = r.iter().map(|x| x * x).sum::<f64>().sqrt();
+    v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keeps_the_normal_equations() {
+        let (m, n) = (200, 5);
+        let j = DMatrix::from_fn(m, n, |i, c| ((i * (c + 3)) as f64 * 0.37).sin() + if c == 2 { 0.0 } else { 0.1 });
+        let mut j = j;
+        j.column_mut(4).fill(0.0); // a frozen direction
+        let r: Vec<f64> = (0..m).map(|i| (i as f64 * 0.11).cos()).collect();
+        let a = reduced(&j, &r);
+        let b = reduced_residuals(&r, n);
+        let rv = DVector::from_vec(r.clone());
+        assert!(((a.transpose() * &a) - j.transpose() * &j).amax() < 1e-9);
+        assert!(((a.transpose() * &b) - j.transpose() * &rv).amax() < 1e-9);
+        assert!((b.norm() - rv.norm()).abs() < 1e-12);
+    }
+}
