@@ -31,7 +31,9 @@ fn layout(browser: &Path, page: &Path) -> serde_json::Value {
     let checked = page.with_file_name("layout-check.html");
     let html = html.replace("</body>", &format!("<script>{CHECK_JS}</script></body>"));
     std::fs::write(&checked, html).unwrap();
-    let profile = scratch("chromium-profile");
+    // A profile of this page's own: two browsers on one profile (the tests run side by side)
+    // hand over to each other through its lock, and one of them dumps nothing.
+    let profile = page.with_file_name("chromium-profile");
     let out = Command::new(browser)
         .args([
             "--headless",
@@ -52,9 +54,14 @@ fn layout(browser: &Path, page: &Path) -> serde_json::Value {
         .output()
         .expect("running chromium");
     let dom = String::from_utf8_lossy(&out.stdout);
-    let start = dom
-        .rfind("<pre id=\"layout-check\">")
-        .unwrap_or_else(|| panic!("no check result in the DOM of {}", page.display()));
+    let start = dom.rfind("<pre id=\"layout-check\">").unwrap_or_else(|| {
+        panic!(
+            "no check result in the DOM of {} (chromium {}; stderr: {})",
+            page.display(),
+            out.status,
+            String::from_utf8_lossy(&out.stderr).trim()
+        )
+    });
     let rest = &dom[start + "<pre id=\"layout-check\">".len()..];
     let json = rest.split("</pre>").next().unwrap();
     let json = json.replace("&quot;", "\"").replace("&lt;", "<").replace("&gt;", ">").replace("&amp;", "&");
