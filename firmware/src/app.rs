@@ -163,8 +163,7 @@ async fn main(spawner: Spawner) {
     if loaded.damaged {
         controller::STALLED.store(true, Ordering::Relaxed);
     }
-    let control_hz = loaded.lp.control_hz();
-    controller::CONTROL_HZ_NOW.store(control_hz, Ordering::Relaxed);
+    let (period_cycles, period_us) = controller::periods(loaded.lp.control_hz());
     critical_section::with(|cs| {
         controller::CONTROL.borrow_ref_mut(cs).replace(Control {
             lp: loaded.lp,
@@ -172,8 +171,8 @@ async fn main(spawner: Spawner) {
             _pwm: pwm,
             adc,
             max_duty,
-            period_cycles: board::CORE_HZ / control_hz,
-            period_us: 1_000_000 / control_hz,
+            period_cycles,
+            period_us,
             t_us: 0,
             overrun: false,
             bridge: firmware::bridge::Bridge::Off,

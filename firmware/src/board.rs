@@ -29,9 +29,9 @@ pub const CAN_BITRATE: u32 = 1_000_000;
 /// `firmware::application::can::ID_REPLY`.
 pub use firmware::application::can::ID_CMD as CAN_ID_CMD;
 /// The serial link's baud rate (`hil-sim board --port /dev/ttyACM0` uses the same).
-pub const UART_BAUD: u32 = 921_600;
-/// Independent watchdog timeout, µs.
-pub const WATCHDOG_US: u32 = 50_000;
+pub use firmware::application::serial::BAUD as UART_BAUD;
+/// Independent watchdog timeout, µs (the virtual board models the same).
+pub use firmware::application::watchdog::TIMEOUT_US as WATCHDOG_US;
 
 /// Everything the application takes from the chip.
 pub struct Board {

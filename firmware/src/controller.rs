@@ -49,6 +49,11 @@ pub struct Control {
     pub bridge: Bridge,
 }
 
+/// `(period_cycles, period_us)` of [`Control`] at `control_hz`.
+pub fn periods(control_hz: u32) -> (u32, u32) {
+    (board::CORE_HZ / control_hz, 1_000_000 / control_hz)
+}
+
 pub static CONTROL: Mutex<RefCell<Option<Control>>> = Mutex::new(RefCell::new(None));
 /// A validated controller waiting to be swapped in between two samples.
 pub static PENDING: Mutex<RefCell<Option<(Loop, ValidatedConfig)>>> = Mutex::new(RefCell::new(None));
@@ -77,9 +82,6 @@ static LAST_SEEN: AtomicU32 = AtomicU32::new(0);
 /// Telemetry snapshots per second: every `control_hz / TELEMETRY_HZ`-th sample is kept
 /// (2000 at 20 kHz), the same 10 Hz at every model's control rate.
 pub const TELEMETRY_HZ: u32 = 10;
-/// The running controller's control rate, Hz (`Loop::control_hz`; set at start-up and when
-/// a page is swapped in): the serial stream's time stamps.
-pub static CONTROL_HZ_NOW: AtomicU32 = AtomicU32::new(firmware::bringup::CONTROL_HZ);
 pub static TELEMETRY: Mutex<Cell<Snapshot>> = Mutex::new(Cell::new(Snapshot::EMPTY));
 
 /// Every `STREAM_DECIMATION`-th sample goes to [`STREAM`] (0: none); set by the serial task.
@@ -160,10 +162,8 @@ fn ADC1_2() {
                 c.cfg = cfg;
                 // Its control rate from the next update event on (issue 17).
                 let hz = c.lp.control_hz();
-                c.period_cycles = board::CORE_HZ / hz;
-                c.period_us = 1_000_000 / hz;
+                (c.period_cycles, c.period_us) = periods(hz);
                 board::set_repetition(board::repetition_for(hz));
-                CONTROL_HZ_NOW.store(hz, Ordering::Relaxed);
             }
         }
         let reference = f32::from_bits(REFERENCE.load(Ordering::Relaxed));

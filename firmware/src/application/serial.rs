@@ -14,6 +14,10 @@ use super::ports::{Clock, ControlPort, Events, FlashPages};
 use super::time::with_timeout;
 use super::App;
 
+/// The link's baud rate, 8N1 (LPUART1 on the board; `hil-sim board --port /dev/ttyACM0`
+/// opens the port at the same).
+pub const BAUD: u32 = 921_600;
+
 /// The longest the task sleeps on a silent link, µs (it drains the stream ring then).
 pub const POLL_US: u64 = 500;
 

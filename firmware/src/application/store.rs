@@ -50,8 +50,11 @@ pub fn runnable(img: &ConfigImage) -> Result<(Loop, ValidatedConfig), PageError>
     Loop::from_image(img).map(|lp| (lp, img.control))
 }
 
+/// A usable slot's controller, its configuration and its page's CRC-32.
+pub type Usable = (Loop, ValidatedConfig, u32);
+
 /// What one slot holds, and its controller when it holds a usable page.
-pub fn inspect(flash: &impl FlashPages, slot: Slot) -> (SlotState, Option<(Loop, ValidatedConfig)>) {
+pub fn inspect(flash: &impl FlashPages, slot: Slot) -> (SlotState, Option<Usable>) {
     let Ok(bytes) = flash.read(slot) else {
         return (SlotState::Unusable("uncorrectable ECC error"), None);
     };
@@ -64,7 +67,7 @@ pub fn inspect(flash: &impl FlashPages, slot: Slot) -> (SlotState, Option<(Loop,
         slots::Record::Broken => return (SlotState::Unusable("commit record cut (interrupted commit)"), None),
     };
     let image = bytes.get(..slots::IMAGE_BYTES).unwrap_or(&[]);
-    match ConfigImage::decode(image).and_then(|img| runnable(&img)) {
+    match ConfigImage::decode(image).and_then(|img| runnable(&img).map(|(lp, cfg)| (lp, cfg, img.crc()))) {
         Ok(c) => (SlotState::Valid(seq), Some(c)),
         Err(e) => (SlotState::Unusable(page_error(&e)), None),
     }
@@ -82,12 +85,6 @@ pub struct Loaded {
     pub crc: u32,
 }
 
-/// CRC-32 of the page in `slot` (0 when it does not read or decode).
-fn slot_crc(flash: &impl FlashPages, slot: Slot) -> u32 {
-    let Ok(bytes) = flash.read(slot) else { return 0 };
-    ConfigImage::decode(bytes.get(..slots::IMAGE_BYTES).unwrap_or(&[])).map_or(0, |img| img.crc())
-}
-
 /// The newer valid slot, or the defaults (blank board), or the defaults with `damaged`
 /// set. `Err`: the compiled-in configuration itself is refused (a build error).
 pub fn load(flash: &impl FlashPages, events: &impl Events) -> Result<Loaded, PageError> {
@@ -100,9 +97,8 @@ pub fn load(flash: &impl FlashPages, events: &impl Events) -> Result<Loaded, Pag
         Boot::Slot(Slot::B, _) => cb,
         Boot::Blank | Boot::Damaged => None,
     };
-    if let (Boot::Slot(slot, seq), Some((lp, cfg))) = (boot, chosen) {
+    if let (Boot::Slot(slot, seq), Some((lp, cfg, crc))) = (boot, chosen) {
         events.event(Event::Loaded(slot, seq));
-        let crc = slot_crc(flash, slot);
         return Ok(Loaded { lp, cfg, running: Some((slot, seq)), damaged: false, crc });
     }
     let damaged = boot == Boot::Damaged;
@@ -112,7 +108,8 @@ pub fn load(flash: &impl FlashPages, events: &impl Events) -> Result<Loaded, Pag
 }
 
 /// Validate the received page, write it to the slot not running (erase, image, commit
-/// record last; the flash waits yield), read it back, hand it to the control interrupt.
+/// record last; the flash waits yield), read it back, hand the controller built from the
+/// read-back to the control interrupt.
 /// The new (slot, commit).
 pub async fn commit<C: Clock, F: FlashPages, P: ControlPort, E: Events>(
     app: App<'_, C, F, P, E>,
@@ -132,16 +129,16 @@ pub async fn commit<C: Clock, F: FlashPages, P: ControlPort, E: Events>(
         app.events.event(Event::CommitFailed(slot, e));
         Nack::Flash
     })?;
-    match inspect(app.flash, slot) {
-        (SlotState::Valid(s), _) if s == seq => {}
+    // The controller handed over is the one built from what the slot reads back.
+    let (lp, cfg, crc) = match inspect(app.flash, slot) {
+        (SlotState::Valid(s), Some(usable)) if s == seq => usable,
         (state, _) => {
             app.events.event(Event::ReadBack(slot, state));
             return Err(Nack::Flash);
         }
-    }
-    let (lp, cfg) = runnable(img).map_err(|_| Nack::InvalidPage)?;
+    };
     let model = lp.model_id();
-    app.ctl.hand_over(lp, cfg, img.crc());
+    app.ctl.hand_over(lp, cfg, crc);
     // A board held by a damaged configuration runs again once a good page is committed.
     if app.shared.damaged.swap(false, Ordering::Relaxed) {
         app.ctl.request_reset();

@@ -6,6 +6,10 @@ use super::ports::{Clock, ControlPort, Event, Events, Watchdog};
 use super::time::Ticker;
 use super::App;
 
+/// The independent watchdog's timeout, µs (the board's IWDG; the virtual board models the
+/// same).
+pub const TIMEOUT_US: u32 = 50_000;
+
 /// How often the control interrupt's progress is checked, µs (well inside the watchdog's
 /// timeout).
 pub const CHECK_US: u64 = 10_000;

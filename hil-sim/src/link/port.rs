@@ -12,8 +12,8 @@ impl<T: Read + Write + Send> Stream for T {}
 
 /// How long one read waits.
 pub const POLL: Duration = Duration::from_millis(5);
-/// The UART link's baud rate (the ST-LINK virtual COM port carries it).
-pub const BAUD: u32 = 921_600;
+/// The UART link's baud rate (the firmware's; the ST-LINK virtual COM port carries it).
+pub use firmware::application::serial::BAUD;
 
 /// Open `port`.
 pub fn open(port: &str) -> Result<Box<dyn Stream>, LinkError> {

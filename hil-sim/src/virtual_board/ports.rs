@@ -141,7 +141,7 @@ impl ControlPort for SimControl {
     fn request_reset(&self) {
         self.reset.set(true);
     }
-    /// The latest sample's figures (the board's status reads its 10 Hz snapshot).
+    /// The latest sample's figures (as the board's: stored every period).
     fn status(&self) -> StatusFigures {
         let o = self.last.get().out;
         StatusFigures {
@@ -183,8 +183,8 @@ impl ControlPort for SimControl {
     }
 }
 
-/// Independent watchdog timeout, µs (the board's `WATCHDOG_US`).
-pub const WATCHDOG_US: u64 = 50_000;
+/// Independent watchdog timeout, µs (the board's).
+pub const WATCHDOG_US: u64 = firmware::application::watchdog::TIMEOUT_US as u64;
 
 /// The modelled IWDG: once started, it expires [`WATCHDOG_US`] after the last pet.
 pub struct SimWatchdog<'a> {
