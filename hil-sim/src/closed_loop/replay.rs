@@ -1,5 +1,5 @@
 //! A board's session again, through the bench `hil-sim loop` runs: the journal a virtual
-//! board writes (`K ref V`, `K enable 0|1`, `K reset`, `K release`, `K page CRC`: what it
+//! board writes (`K ref V`, `K enable 0|1`, `K reset`, `K page CRC`: what it
 //! applied from sample K on) replayed sample by sample on [`rig`](super::rig) with the
 //! firmware's own controller (`firmware::runner::Loop`, built by the configuration store's
 //! `runnable`, the function the board commits with): the compiled-in configuration until
@@ -23,8 +23,6 @@ pub enum Applied {
     Enable(bool),
     /// A latched fault cleared (this sample only).
     Reset,
-    /// The command timeout: drive off, reference 0.
-    Release,
     /// A committed page (its CRC) swapped in before this sample.
     Page(u32),
 }
@@ -39,9 +37,7 @@ pub struct Event {
 
 #[derive(Debug, Error)]
 pub enum ReplayError {
-    #[error(
-        "journal line {line}: `{text}`: expected `K ref V`, `K enable 0|1`, `K reset`, `K release` or `K page CRC`"
-    )]
+    #[error("journal line {line}: `{text}`: expected `K ref V`, `K enable 0|1`, `K reset` or `K page CRC`")]
     Line { line: usize, text: String },
     #[error("journal line {line}: sample {k} comes before sample {before}")]
     Order { line: usize, k: usize, before: usize },
@@ -63,7 +59,6 @@ pub fn parse_journal(text: &str) -> Result<Vec<Event>, ReplayError> {
             (Some("enable"), Some("0")) => Applied::Enable(false),
             (Some("enable"), Some("1")) => Applied::Enable(true),
             (Some("reset"), None) => Applied::Reset,
-            (Some("release"), None) => Applied::Release,
             (Some("page"), Some(v)) => {
                 Applied::Page(u32::from_str_radix(v.trim_start_matches("0x"), 16).map_err(|_| bad())?)
             }
@@ -121,10 +116,6 @@ pub fn replay(
                 Applied::Reference(v) => reference = v,
                 Applied::Enable(on) => cmd.enable = on,
                 Applied::Reset => cmd.reset = true,
-                Applied::Release => {
-                    cmd.enable = false;
-                    reference = 0.0;
-                }
                 Applied::Page(crc) if crc != page.crc() => {
                     return Err(ReplayError::OtherPage { k: e.k, journal: crc, given: page.crc() })
                 }
@@ -174,7 +165,7 @@ mod tests {
 
     #[test]
     fn a_journal_parses_and_a_bad_line_is_named() {
-        let ev = parse_journal("0 ref 1.5\n10 enable 1\n12 page 0x0000abcd\n20 reset\n30 release\n").expect("journal");
+        let ev = parse_journal("0 ref 1.5\n10 enable 1\n12 page 0x0000abcd\n20 reset\n30 enable 0\n").expect("journal");
         assert_eq!(ev[0], Event { k: 0, applied: Applied::Reference(1.5) });
         assert_eq!(ev[2].applied, Applied::Page(0xabcd));
         assert_eq!(ev.len(), 5);

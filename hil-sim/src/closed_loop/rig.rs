@@ -83,6 +83,12 @@ pub struct Rig {
     t0: f64,
 }
 
+/// Samples between slow supervisor passes at time step `dt`, s: the pass at
+/// [`SLOW_HZ`](firmware::runner::SLOW_HZ), as the firmware's `supervisor` task asks for it.
+fn slow_every(dt: f64) -> usize {
+    ((1.0 / f64::from(firmware::runner::SLOW_HZ) / dt).round() as usize).max(1)
+}
+
 impl Rig {
     /// A fresh plant (noise seed `seed`) at the time step of `cfg`, with `fault` scheduled.
     pub fn new(clutch: &ClutchParams, cfg: &ValidatedConfig, seed: u64, fault: Option<Schedule>) -> Self {
@@ -93,8 +99,7 @@ impl Rig {
             fault,
             injected: false,
             applied: (0.0, false),
-            // The slow supervisor pass at 1 kHz, as the firmware's `supervisor` task runs it.
-            slow_every: ((1e-3 / dt).round() as usize).max(1),
+            slow_every: slow_every(dt),
             use_temp: cfg.get().temp_coeff != 0.0,
             dt,
             k: 0,
@@ -112,7 +117,7 @@ impl Rig {
         self.t0 = self.time();
         self.k0 = self.k;
         self.dt = dt;
-        self.slow_every = ((1e-3 / dt).round() as usize).max(1);
+        self.slow_every = slow_every(dt);
     }
 
     /// Time of the next sample, s.
