@@ -61,9 +61,6 @@ impl CanCodec {
     }
 }
 
-/// The command identifier (the board's acceptance filter).
-pub const COMMAND_ID: u16 = ID_CMD;
-
 #[cfg(target_os = "linux")]
 mod socket {
     use std::io::{self, ErrorKind, Read, Write};
@@ -71,7 +68,7 @@ mod socket {
 
     use socketcan::{CanFrame, CanSocket, EmbeddedFrame, Id, Socket, StandardId};
 
-    use super::{CanCodec, COMMAND_ID};
+    use super::{CanCodec, ID_CMD};
 
     /// A SocketCAN raw socket as the client's byte stream.
     pub struct CanStream {
@@ -104,7 +101,7 @@ mod socket {
 
     impl Write for CanStream {
         fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-            let id = StandardId::new(COMMAND_ID).ok_or_else(|| io::Error::other("CAN identifier"))?;
+            let id = StandardId::new(ID_CMD).ok_or_else(|| io::Error::other("CAN identifier"))?;
             for p in self.codec.outgoing(buf) {
                 let f = CanFrame::new(id, &p).ok_or_else(|| io::Error::other("CAN frame"))?;
                 self.socket.write_frame(&f)?;
@@ -152,7 +149,7 @@ mod tests {
     fn the_firmware_reply_comes_back_as_a_client_frame() {
         let mut c = CanCodec::default();
         let f = reply(Response::Ack(3)).expect("reply frame");
-        assert!(!c.incoming(COMMAND_ID, f.data()), "a frame from another id is not a reply");
+        assert!(!c.incoming(ID_CMD, f.data()), "a frame from another id is not a reply");
         assert!(c.incoming(f.id, f.data()));
         let mut buf = [0u8; 64];
         let n = c.read(&mut buf);
