@@ -182,10 +182,11 @@ pub struct FitResult {
 }
 
 /// Fit model `id` to `data`. A fitted delay that ends at the edge of its search range is
-/// held at zero and the model refitted, with a warning ([`identifiable`]); so is a parameter
-/// whose confidence interval spans zero, when holding it costs little ([`hold`]).
+/// held at zero and the model refitted from the first search's parameters, with a warning
+/// ([`identifiable`]); a parameter whose confidence interval spans zero is held at zero
+/// when holding it costs little ([`hold`]).
 pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, FitError> {
-    let first = search(id, data, opts)?;
+    let first = search(id, data, opts, None)?;
     let dt = data.dt;
     let (d, d_u) = first.delays;
     let (edge_x, edge_u) = (identifiable::at_edge(d), identifiable::at_edge(d_u));
@@ -199,9 +200,10 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     if edge_u {
         which.push(("command", d_u));
     }
-    // The first search is not finished (scored, checked): its delays are discarded.
+    // The first search is not finished (scored, checked): its delays are discarded, its
+    // parameters are where the refit starts (a second global search cost as much as the first).
     let held = DelayChoice::Fixed(if edge_x { 0.0 } else { d * dt }, if edge_u { 0.0 } else { d_u * dt });
-    let mut r = search(id, data, &FitOptions { delay: held, ..*opts })?;
+    let mut r = search(id, data, &FitOptions { delay: held, ..*opts }, Some((&first.params, first.variant)))?;
     r.seconds += first.seconds;
     r.evaluations += first.evaluations;
     finish(id, data, opts, r, Some(identifiable::edge_warning(&which, dt)))
@@ -217,16 +219,19 @@ struct Searched {
     kin: Vec<model_core::Kin>,
     rows: Vec<usize>,
     constant_u: Option<f64>,
-    /// The model's parameters (no delay entries), the evaluations spent, the delays (samples).
+    /// The model's parameters (no delay entries), the evaluations spent, the variant of the
+    /// search they come from, the delays (samples).
     params: Vec<f64>,
     evaluations: usize,
+    variant: usize,
     delays: (f64, f64),
     notes: Vec<String>,
     seconds: f64,
 }
 
-/// The search of [`fit`] under `opts.delay`, without the checks and the scores.
-fn search(id: &str, data: &Dataset, opts: &FitOptions) -> Result<Searched, FitError> {
+/// The search of [`fit`] under `opts.delay`, without the checks and the scores; from `warm`
+/// (the model's parameters and their variant) by a local search when given ([`warm_fit`]).
+fn search(id: &str, data: &Dataset, opts: &FitOptions, warm: Option<(&[f64], usize)>) -> Result<Searched, FitError> {
     // A command that never changes cannot identify the terms it drives: fit the model's
     // no-command form (those terms held) and say so.
     let constant_u = identifiable::constant_command(data);
@@ -242,11 +247,12 @@ fn search(id: &str, data: &Dataset, opts: &FitOptions) -> Result<Searched, FitEr
     let sim = simulate::simulator_runs(id, dt, &starts).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
     let rows = data.train_rows();
     let notes = restarts::Notes::default();
-    let fit_at = |kin: &[model_core::Kin], sp: &ModelSpec| {
-        identify_variants(id, sp, sim.as_ref(), kin, &data.output, &rows, &scales, opts, &notes)
+    let fit_at = |kin: &[model_core::Kin], sp: &ModelSpec| match warm {
+        Some(w) => warm_fit(id, sp, w, sim.as_ref(), (kin, &data.output, &rows), &scales, opts, &notes),
+        None => identify_variants(id, sp, sim.as_ref(), kin, &data.output, &rows, &scales, opts, &notes),
     };
     let n_model = sim.n_params();
-    let ((mut params, evaluations), delays) = match (opts.delay, sp.strategy) {
+    let (found, delays) = match (opts.delay, sp.strategy) {
         (DelayChoice::Off, _) => (fit_at(&kin, &sp)?, (0.0, 0.0)),
         (DelayChoice::Fixed(s, s_u), _) => {
             let d = (s / data.dt, if data.command.is_some() { s_u / data.dt } else { 0.0 });
@@ -260,7 +266,7 @@ fn search(id: &str, data: &Dataset, opts: &FitOptions) -> Result<Searched, FitEr
         (DelayChoice::Auto, Strategy::Linear | Strategy::Operator) => {
             let found = scan_delay(&kin, &starts, |k| {
                 let r = fit_at(k, &sp).ok()?;
-                let cost = Objective::new(sim.as_ref(), &sp, k, &data.output, &rows, scales.y).cost(&r.0);
+                let cost = Objective::new(sim.as_ref(), &sp, k, &data.output, &rows, scales.y).cost(&r.params);
                 Some((r, cost))
             })
             .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
@@ -271,11 +277,12 @@ fn search(id: &str, data: &Dataset, opts: &FitOptions) -> Result<Searched, FitEr
                 data.command.is_some() && uses_command(id, &scales),
                 crate::models::alignment::MAX_DELAY_SAMPLES,
             );
-            let (p, e) = fit_at(&kin, &spd)?;
-            let d = (p.get(n_model).copied().unwrap_or(0.0), p.get(n_model + 1).copied().unwrap_or(0.0));
-            ((p, e), d)
+            let r = fit_at(&kin, &spd)?;
+            let d = (r.params.get(n_model).copied().unwrap_or(0.0), r.params.get(n_model + 1).copied().unwrap_or(0.0));
+            (r, d)
         }
     };
+    let Identified { mut params, evaluations, variant } = found;
     params.truncate(n_model);
     let notes = notes.into_inner().unwrap_or_default();
     let seconds = started.elapsed().as_secs_f64();
@@ -290,6 +297,7 @@ fn search(id: &str, data: &Dataset, opts: &FitOptions) -> Result<Searched, FitEr
         constant_u,
         params,
         evaluations,
+        variant,
         delays,
         notes,
         seconds,
@@ -394,6 +402,14 @@ fn uses_command(id: &str, scales: &Scales) -> bool {
     free(&Scales { u: None, ..*scales }) < free(scales)
 }
 
+/// A search's result: parameters, model evaluations spent, and which variant of the search
+/// ([`crate::models::HostModel::variant`], 0: the model's spec) they belong to.
+struct Identified {
+    params: Vec<f64>,
+    evaluations: usize,
+    variant: usize,
+}
+
 /// [`identify`] for every variant of the search ([`crate::models::HostModel::variant`]); the lowest training
 /// cost wins.
 #[allow(clippy::too_many_arguments)]
@@ -407,7 +423,7 @@ fn identify_variants(
     scales: &Scales,
     opts: &FitOptions,
     notes: &restarts::Notes,
-) -> Result<(Vec<f64>, usize), FitError> {
+) -> Result<Identified, FitError> {
     let mut best: Option<(Vec<f64>, usize, f64)> = None;
     let mut evals = 0;
     let mut first_err = None;
@@ -419,7 +435,7 @@ fn identify_variants(
                 evals += e;
                 let cost = Objective::new(sim, &v, kin, y, rows, scales.y).cost(&p);
                 if best.as_ref().is_none_or(|b| cost < b.2) {
-                    best = Some((p, e, cost));
+                    best = Some((p, k, cost));
                 }
             }
             Err(e) => first_err = first_err.or(Some(e)),
@@ -428,10 +444,65 @@ fn identify_variants(
         current = crate::models::host(sp.id).and_then(|h| h.variant(sp, k, scales));
     }
     match (best, first_err) {
-        (Some((p, _, _)), _) => Ok((p, evals)),
+        (Some((params, variant, _)), _) => Ok(Identified { params, evaluations: evals, variant }),
         (None, Some(e)) => Err(e),
         (None, None) => Err(FitError::NoValidSet { model: id.to_owned() }),
     }
+}
+
+/// A local search from `warm`, a fitted parameter set of the model (no delay entries) and the
+/// variant of the search it came from: Levenberg–Marquardt on the whole training part, over
+/// the shape only for a projected model. The strategies without a global phase get
+/// [`identify_variants`].
+#[allow(clippy::too_many_arguments)]
+fn warm_fit(
+    id: &str,
+    sp: &ModelSpec,
+    (warm, variant): (&[f64], usize),
+    sim: &dyn simulate::Simulator,
+    (kin, y, rows): (&[model_core::Kin], &[f64], &[usize]),
+    scales: &Scales,
+    opts: &FitOptions,
+    notes: &restarts::Notes,
+) -> Result<Identified, FitError> {
+    let v = match variant {
+        0 => Some(sp.clone()),
+        k => crate::models::host(sp.id).and_then(|h| h.variant(sp, k, scales)),
+    };
+    let Some(mut v) = v.filter(|v| matches!(v.strategy, Strategy::Global | Strategy::Projected)) else {
+        return identify_variants(id, sp, sim, kin, y, rows, scales, opts, notes);
+    };
+    for (p, w) in v.params.iter_mut().zip(warm) {
+        p.start = w.clamp(p.lo, p.hi);
+    }
+    let (params, evaluations) = if v.strategy == Strategy::Projected {
+        let proj = operator::Projected::new(sim, y, rows).ok_or_else(|| FitError::NotFittable(id.to_owned()))?;
+        let shape = projected_shape(&v, kin, rows);
+        let r =
+            lm::minimize(&Objective::new(&proj, &shape, kin, y, rows, scales.y), &shape.start(), opts.lm_iterations);
+        let full = proj.complete(&r.params, kin).ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
+        valid_or_err(id, sim, full, r.evaluations)?
+    } else {
+        let r = lm::minimize(&Objective::new(sim, &v, kin, y, rows, scales.y), &v.start(), opts.lm_iterations);
+        valid_or_err(id, sim, r.params, r.evaluations)?
+    };
+    Ok(Identified { params, evaluations, variant })
+}
+
+/// The shape search of a projected model: `sp` with the grid / radii spanning the training
+/// range (`x_min`, `x_max` held there) and a global strategy.
+fn projected_shape(sp: &ModelSpec, kin: &[model_core::Kin], rows: &[usize]) -> ModelSpec {
+    let end = rows.last().map_or(0, |r| r + 1).min(kin.len());
+    let (lo, hi) = operator::x_range(kin, end);
+    let pad = 1e-3 * (hi - lo).max(1e-12);
+    let mut shape = sp.clone();
+    shape.strategy = Strategy::Global;
+    for (name, v) in [("x_min", lo - pad), ("x_max", hi + pad)] {
+        if let Some(p) = shape.params.iter_mut().find(|p| p.name == name) {
+            (p.lo, p.hi, p.start) = (v, v, v);
+        }
+    }
+    shape
 }
 
 /// The search itself: returns the parameters and the number of model evaluations.
@@ -474,17 +545,7 @@ fn identify(
         }
         Strategy::Projected => {
             let proj = operator::Projected::new(sim, y, rows).ok_or_else(|| FitError::NotFittable(id.to_owned()))?;
-            // The grid / radii span the training range.
-            let end = rows.last().map_or(0, |r| r + 1).min(kin.len());
-            let (lo, hi) = operator::x_range(kin, end);
-            let pad = 1e-3 * (hi - lo).max(1e-12);
-            let mut shape = sp.clone();
-            shape.strategy = Strategy::Global;
-            for (name, v) in [("x_min", lo - pad), ("x_max", hi + pad)] {
-                if let Some(p) = shape.params.iter_mut().find(|p| p.name == name) {
-                    (p.lo, p.hi, p.start) = (v, v, v);
-                }
-            }
+            let shape = projected_shape(sp, kin, rows);
             let (p, evals) = identify(id, &shape, &proj, kin, y, rows, y_scale, opts, notes)?;
             let full = proj.complete(&p, kin).ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
             valid_or_err(id, sim, full, evals)
