@@ -110,7 +110,7 @@ fn refit(
         return None;
     }
     let obj = Objective::new(f.sim, &s, kin, f.y, f.rows, f.scale);
-    let r = lm::minimize(&obj, &start, lm_iterations);
+    let r = lm::minimize_reduced(&obj, &start, lm_iterations);
     (r.cost.is_finite() && f.sim.valid(&r.params)).then_some((r.params, r.cost, r.evaluations))
 }
 

@@ -4,8 +4,9 @@
 //! Each free parameter's box position `s ∈ [0, 1]` is written `s = (1 + sin θ)/2` with `θ`
 //! unconstrained (the MINUIT transform), so every trial point the solver proposes is inside
 //! the box. The Jacobian is a forward difference in `θ` through the f32 core, its columns
-//! computed in parallel. For the networks ([`minimize_reduced`]) the solver is handed the
-//! problem reduced to one row per parameter ([`crate::numerics::reduce`]).
+//! computed in parallel. For the networks and the runs on the whole training part
+//! ([`minimize_reduced`]) the solver is handed the problem reduced to one row per parameter
+//! ([`crate::numerics::reduce`]).
 
 use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
 use nalgebra::storage::Owned;
@@ -119,11 +120,13 @@ pub fn minimize(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> Lo
 }
 
 /// [`minimize`] with the solver's problem reduced to one row per parameter
-/// ([`crate::numerics::reduce`]): the same steps up to round-off, for many rows and many
-/// parameters (the Hammerstein–Wiener network), where factoring the full Jacobian is a large
-/// part of the cost. The global searches keep the crate's factorisation: there it is a tenth
-/// of the cost or less, and a change of round-off moves which restarts agree (Spencer's
-/// model on `ranran_50.csv` then needed a fourth start: slower, not faster).
+/// ([`crate::numerics::reduce`]): the same steps up to round-off, for many rows, where
+/// factoring the full Jacobian is a large part of the cost: the networks, and every run on
+/// the whole training part (the final run of a global search, the refits of [`super::hold`]
+/// and after a delay held at zero). The restarts of a global search, on its window, keep the
+/// crate's factorisation: there it is a tenth of the cost or less, and a change of round-off
+/// moves which restarts agree (Spencer's model on `ranran_50.csv` then needed a fourth
+/// start: slower, not faster).
 pub fn minimize_reduced(obj: &Objective<'_>, start: &[f64], max_iterations: usize) -> LocalFit {
     minimize_with(obj, start, max_iterations, true)
 }

@@ -478,12 +478,15 @@ fn warm_fit(
     let (params, evaluations) = if v.strategy == Strategy::Projected {
         let proj = operator::Projected::new(sim, y, rows).ok_or_else(|| FitError::NotFittable(id.to_owned()))?;
         let shape = projected_shape(&v, kin, rows);
-        let r =
-            lm::minimize(&Objective::new(&proj, &shape, kin, y, rows, scales.y), &shape.start(), opts.lm_iterations);
+        let r = lm::minimize_reduced(
+            &Objective::new(&proj, &shape, kin, y, rows, scales.y),
+            &shape.start(),
+            opts.lm_iterations,
+        );
         let full = proj.complete(&r.params, kin).ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
         valid_or_err(id, sim, full, r.evaluations)?
     } else {
-        let r = lm::minimize(&Objective::new(sim, &v, kin, y, rows, scales.y), &v.start(), opts.lm_iterations);
+        let r = lm::minimize_reduced(&Objective::new(sim, &v, kin, y, rows, scales.y), &v.start(), opts.lm_iterations);
         valid_or_err(id, sim, r.params, r.evaluations)?
     };
     Ok(Identified { params, evaluations, variant })
@@ -629,7 +632,7 @@ fn global_fit(
     let Some(best) = best else {
         return Err(failure.unwrap_or_else(|| FitError::NoValidSet { model: id.to_owned() }));
     };
-    let r = lm::minimize(full, &best.params, opts.lm_iterations);
+    let r = lm::minimize_reduced(full, &best.params, opts.lm_iterations);
     evals += r.evaluations;
     valid_or_err(id, sim, r.params, evals)
 }
