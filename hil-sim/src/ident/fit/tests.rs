@@ -69,3 +69,24 @@ fn iterative_fit_finds_a_known_input_delay() {
     let fixed = fit("bouc_wen", &data, &opts(DelayChoice::Fixed(-2.5e-3, 0.0))).unwrap();
     assert!((fixed.delay_s + 2.5e-3).abs() < 1e-12);
 }
+
+/// A delay beyond the search range ends at its edge: it is held at zero, named, and the
+/// model refitted from the first search's parameters, which finds as good a fit as a whole
+/// new search with the delay at zero for a fraction of its runs.
+#[test]
+fn a_delay_at_the_edge_is_held_at_zero_and_refitted_from_the_first_search() {
+    let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
+    let data = lagged("bouc_wen", &truth, 14.0, false);
+    let auto = fit("bouc_wen", &data, &opts(DelayChoice::Auto)).unwrap();
+    let zero = fit("bouc_wen", &data, &opts(DelayChoice::Fixed(0.0, 0.0))).unwrap();
+    assert_eq!(auto.delay_s, 0.0);
+    assert!(auto.warnings.iter().any(|w| w.contains("input delay") && w.contains("edge")), "{:?}", auto.warnings);
+    assert!(
+        auto.train.rmse <= 1.02 * zero.train.rmse,
+        "warm refit {} vs new search {}",
+        auto.train.rmse,
+        zero.train.rmse
+    );
+    // The first search plus the refit cost less than one and a half new searches (two before).
+    assert!(2 * auto.evaluations < 3 * zero.evaluations, "{} vs {} runs", auto.evaluations, zero.evaluations);
+}
