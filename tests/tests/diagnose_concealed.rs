@@ -12,7 +12,8 @@
 //! - [`bench_table`] (ignored, about an hour): the full table, per effect and per excitation:
 //!   `BENCH_SET=heldout cargo test --release -p tests --test diagnose_concealed -- --ignored
 //!   --nocapture` (`BENCH_SET=dev` for the development seeds, `BENCH_N`, `BENCH_NULL` for
-//!   the number of effect and null cases, default 256 and 48). It prints one line per case
+//!   the number of effect and null cases, default 256 and 48; `BENCH_MIN_FS`, `BENCH_MAX_FS`
+//!   keep only the cases sampled within those rates, Hz). It prints one line per case
 //!   and writes `target/bench_<set>.md`.
 
 use std::collections::BTreeMap;
@@ -206,8 +207,10 @@ fn bench_table() {
     let n = std::env::var("BENCH_N").ok().and_then(|v| v.parse().ok()).unwrap_or(256);
     let n_null = std::env::var("BENCH_NULL").ok().and_then(|v| v.parse().ok()).unwrap_or(48);
     // BENCH_FROM / BENCH_TO: a slice of the list (to share a run between processes).
-    let all = cases(set, n, n_null);
     let env = |k: &str, d: usize| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
+    // BENCH_MIN_FS / BENCH_MAX_FS: only the cases sampled within these rates, Hz.
+    let fs = (env("BENCH_MIN_FS", 0) as f64, env("BENCH_MAX_FS", usize::MAX) as f64);
+    let all: Vec<Case> = cases(set, n, n_null).into_iter().filter(|c| c.fs_hz >= fs.0 && c.fs_hz <= fs.1).collect();
     let (from, to) = (env("BENCH_FROM", 0).min(all.len()), env("BENCH_TO", all.len()).min(all.len()));
     let outcomes = run_all(&all[from..to.max(from)]);
     let t = table(&outcomes);

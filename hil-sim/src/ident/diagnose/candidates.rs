@@ -95,6 +95,29 @@ fn centred(v: &[f64]) -> Vec<f64> {
     v.iter().map(|a| a - m).collect()
 }
 
+/// The local excitation frequency relative to its mean, less 1: `f_loc/f̄ − 1`, with
+/// `2π·f_loc` the RMS rate over the RMS level about the local mean, each smoothed without
+/// delay (forward and backward first-order low-pass, 0.25 s). 0 where the input rests.
+fn local_frequency(x: &[f64], dx: &[f64], dt: f64) -> Vec<f64> {
+    const SMOOTH_S: f64 = 0.25;
+    let zero_phase = |v: &[f64]| -> Vec<f64> {
+        let mut f = lowpass(v, SMOOTH_S, dt);
+        f.reverse();
+        let mut b = lowpass(&f, SMOOTH_S, dt);
+        b.reverse();
+        b
+    };
+    let level = zero_phase(x);
+    let dev: Vec<f64> = x.iter().zip(&level).map(|(x, m)| (x - m) * (x - m)).collect();
+    let (p_x, p_dx) = (zero_phase(&dev), zero_phase(&dx.iter().map(|d| d * d).collect::<Vec<f64>>()));
+    let f: Vec<f64> = p_x.iter().zip(&p_dx).map(|(px, pd)| if *px > 0.0 { (pd / px).sqrt() } else { 0.0 }).collect();
+    let mean_f = mean(&f);
+    if !(mean_f > 0.0 && mean_f.is_finite()) {
+        return vec![0.0; x.len()];
+    }
+    f.iter().map(|v| if v.is_finite() { v / mean_f - 1.0 } else { 0.0 }).collect()
+}
+
 /// A causal first-order low-pass with time constant `tau_s` (0: unchanged).
 fn lowpass(v: &[f64], tau_s: f64, dt: f64) -> Vec<f64> {
     Transform::Lag { tau_s }.apply(v, dt)
@@ -310,10 +333,14 @@ fn input_transforms(s: &InputStats) -> Vec<Candidate> {
     ]
 }
 
-/// Rate (`c·|ẋ|ẋ`), direction (`δ·(x − x̄)·sgn(ẋ)`, the sign smoothed over 5 % of the
-/// rate's spread) and inertia (`m·ẍ`, from a measured acceleration when there is one).
+/// Rate dependence in three shapes (`c·|ẋ|ẋ`, `c·ẋ³`, and a damping that grows with the
+/// local excitation frequency, `c·(f_loc/f̄ − 1)·ẋ`: the catalog's α(f), beyond the linear
+/// `c·ẋ` a base already has), direction (`δ·(x − x̄)·sgn(ẋ)`, the sign smoothed over 5 % of
+/// the rate's spread) and inertia (`m·ẍ`, from a measured acceleration when there is one).
 fn kinematic_terms(s: &InputStats, aux: &[AuxChannel]) -> Vec<Candidate> {
     let rate_term: Vec<f64> = s.dx.iter().map(|v| v.abs() * v).collect();
+    let cubed: Vec<f64> = s.dx.iter().map(|v| v * v * v).collect();
+    let by_frequency: Vec<f64> = local_frequency(&s.x, &s.dx, s.dt).iter().zip(&s.dx).map(|(f, d)| f * d).collect();
     let asym: Vec<f64> = s.x.iter().zip(&s.dx).map(|(x, d)| (x - s.x_mean) * (d / (0.05 * s.dx_std)).tanh()).collect();
     let acc = aux.iter().find(|a| a.role == Role::InputAcceleration);
     let (acc_values, acc_label, acc_channel) = match acc {
@@ -324,6 +351,14 @@ fn kinematic_terms(s: &InputStats, aux: &[AuxChannel]) -> Vec<Candidate> {
     };
     vec![
         additive("rate_dependence", "term in |rate|·rate".into(), "c_rate", rate_term, None),
+        additive("rate_dependence", "term in rate³".into(), "c_rate3", cubed, None),
+        additive(
+            "rate_dependence",
+            "damping growing with the excitation frequency".into(),
+            "c_freq",
+            by_frequency,
+            None,
+        ),
         additive("asymmetry", "loading/unloading difference growing with the input".into(), "delta", asym, None),
         additive("inertia", acc_label, "m", acc_values, acc_channel),
     ]

@@ -181,6 +181,14 @@ fn what(d: &Described<'_>) -> String {
         "sensor_offset" => {
             format!("the {i} reading carries a zero offset of {} (Hall offset or remanent field)", with_unit(g, &xu))
         }
+        "rate_dependence" if c.label.contains("rate³") => format!(
+            "the loop changes with the excitation rate beyond the model's linear rate term (a rate³ term, coefficient {} per ({xu}/s)³)",
+            with_unit(coef, &yu)
+        ),
+        "rate_dependence" if c.label.contains("frequency") => format!(
+            "the damping grows with the excitation frequency beyond the model's linear rate term (c·(f/f̄ − 1)·rate, c = {} per ({xu}/s))",
+            with_unit(coef, &yu)
+        ),
         "rate_dependence" => format!(
             "the loop changes with the excitation rate beyond the model's linear rate term (a |rate|·rate term, coefficient {} per ({xu}/s)²)",
             with_unit(coef, &yu)
@@ -232,6 +240,8 @@ fn coefficient_unit(name: &str, (i, o): (&str, &str), ch: Option<&str>) -> Optio
     let cu = ch.map(unit_or).unwrap_or_default();
     Some(match name {
         "c_rate" => format!("{yu} per ({xu}/s)²"),
+        "c_rate3" => format!("{yu} per ({xu}/s)³"),
+        "c_freq" => format!("{yu} per ({xu}/s)"),
         "delta" | "k_input" => format!("{yu} per {xu}"),
         "m" if ch.is_some() => format!("{yu} per ({cu})"),
         "m" => format!("{yu} per ({xu}/s²)"),

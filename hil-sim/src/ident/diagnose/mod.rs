@@ -29,6 +29,7 @@ pub mod accept;
 pub mod augment;
 pub mod base;
 pub mod candidates;
+pub mod decimate;
 pub mod describe;
 pub mod diagnosis;
 pub mod leak;
@@ -62,7 +63,37 @@ const BASE_ITERATIONS: usize = 8;
 /// Diagnose `data` (its auxiliary channels `aux`: name and values; the command channel, if
 /// the model uses one, is named by `command`; `names` are the input's and the output's).
 /// One progress stage: a step per base model fitted, one for locating, two per round.
+///
+/// A recording sampled faster than [`decimate::TARGET_HZ`] is diagnosed on block means at
+/// about that rate ([`decimate`]), and a note says so.
 pub fn diagnose(
+    data: &Dataset,
+    aux: Vec<(String, Vec<f64>)>,
+    command: Option<&str>,
+    names: (&str, &str),
+    opts: &DiagnoseOptions,
+    progress: &dyn Progress,
+) -> Result<Diagnosis, DiagnoseError> {
+    let q = decimate::factor(data.dt);
+    if q < 2 {
+        return diagnose_at_rate(data, aux, command, names, opts, progress);
+    }
+    let started = Instant::now();
+    let d = decimate::decimate(data, aux, &opts.boundaries, q);
+    let opts = DiagnoseOptions { boundaries: d.boundaries, ..opts.clone() };
+    let mut out = diagnose_at_rate(&d.data, d.aux, command, names, &opts, progress)?;
+    out.notes.push(format!(
+        "the recording ({:.0} Hz) was diagnosed at {:.0} Hz, on the means of blocks of {q} samples (every effect of the \
+         catalog lives far below that rate)",
+        1.0 / data.dt,
+        1.0 / d.data.dt
+    ));
+    out.seconds = started.elapsed().as_secs_f64();
+    Ok(out)
+}
+
+/// [`diagnose`] at the recording's own rate.
+fn diagnose_at_rate(
     data: &Dataset,
     aux: Vec<(String, Vec<f64>)>,
     command: Option<&str>,

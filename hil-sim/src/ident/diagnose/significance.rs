@@ -6,7 +6,10 @@
 //! long (seconds), so the residual's own correlation stays mostly inside a block and the
 //! block means are close to independent. The candidate is kept when the mean drop is
 //! [`T_MIN`] standard errors above zero (one-sided p ≈ 0.8 % for 9 degrees of freedom,
-//! about 8 % family-wise over the ten or so candidates of a round) **and** the held-out
+//! about 8 % family-wise over the ten or so candidates of a round), or when Wilcoxon's
+//! signed-rank test on the same drops gives p ≤ [`P_RANK_MAX`] (a gain that nearly every
+//! block shows, but of very different sizes: a held-out sweep, whose blocks are different
+//! frequencies, gave t < 3 for a 40 % gain), **and** the held-out
 //! RMSE falls by at least [`MIN_GAIN`]: a recording with nothing missing should produce no
 //! finding, not a statistically real but useless one. The diagnosis also asks that what
 //! the term changes in the prediction (RMS) be at least [`MIN_TERM_OF_NOISE`] × the
@@ -23,6 +26,9 @@ pub const T_MIN: f64 = 3.0;
 pub const MIN_GAIN: f64 = 0.02;
 /// Smallest RMS change of the prediction, in units of the residual's noise floor.
 pub const MIN_TERM_OF_NOISE: f64 = 0.75;
+/// Largest one-sided p of the signed-rank test that counts as significant on its own
+/// (about the t test's at [`T_MIN`]).
+pub const P_RANK_MAX: f64 = 0.005;
 
 /// The outcome of one paired test.
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -34,6 +40,8 @@ pub struct Test {
     /// Blocks whose error dropped.
     pub blocks_better: usize,
     pub blocks: usize,
+    /// One-sided p of Wilcoxon's signed-rank test on the per-block drops (exact).
+    pub p_rank: f64,
     pub significant: bool,
 }
 
@@ -66,13 +74,34 @@ pub fn test(y: &[f64], before: &[f64], after: &[f64], rows: &[usize]) -> Test {
         0.0
     };
     let gain = if sb > 0.0 { 1.0 - (sa / sb).sqrt() } else { 0.0 };
+    let p_rank = signed_rank_p(&drops);
     Test {
         t,
         gain,
         blocks_better: drops.iter().filter(|d| **d > 0.0).count(),
         blocks,
-        significant: t >= T_MIN && gain >= MIN_GAIN,
+        p_rank,
+        significant: (t >= T_MIN || p_rank <= P_RANK_MAX) && gain >= MIN_GAIN,
     }
+}
+
+/// One-sided p of Wilcoxon's signed-rank test that the drops are positive: the chance,
+/// with every sign equally likely, of a rank sum of the negative drops no larger than
+/// observed (exact, by enumerating the signs; ties ranked by order, a zero drop counts as
+/// negative). Blocks of very different sizes of gain (a sweep held out across its
+/// frequencies) give a low t for a gain every block shows; this test reads the signs and
+/// the order of the drops, not their spread.
+fn signed_rank_p(drops: &[f64]) -> f64 {
+    let k = drops.len();
+    if k == 0 || k > 16 {
+        return 1.0;
+    }
+    let mut order: Vec<usize> = (0..k).collect();
+    order.sort_by(|&a, &b| drops[a].abs().total_cmp(&drops[b].abs()));
+    let w_neg: usize = order.iter().enumerate().filter(|(_, &j)| drops[j] <= 0.0).map(|(r, _)| r + 1).sum();
+    let at_most =
+        (0u32..1 << k).filter(|m| (0..k).filter(|r| m & (1 << r) != 0).map(|r| r + 1).sum::<usize>() <= w_neg).count();
+    at_most as f64 / f64::from(1u32 << k)
 }
 
 #[cfg(test)]
@@ -97,5 +126,31 @@ mod tests {
         let other: Vec<f64> = y.iter().zip(&noise2).map(|(y, e)| y + e).collect();
         let t = test(&y, &after, &other, &rows);
         assert!(!t.significant, "{t:?}");
+    }
+
+    #[test]
+    fn the_signed_rank_p_is_exact() {
+        // All ten drops positive: 1 of 1024 sign patterns has a negative rank sum of 0.
+        let all: Vec<f64> = (1..=10).map(f64::from).collect();
+        assert!((signed_rank_p(&all) - 1.0 / 1024.0).abs() < 1e-15);
+        // The smallest negative: rank sums 0 and 1 → 2 of 1024.
+        let mut one = all.clone();
+        one[0] = -1.0;
+        assert!((signed_rank_p(&one) - 2.0 / 1024.0).abs() < 1e-15);
+        // Half of them negative, the largest ones: far from significant.
+        let half: Vec<f64> = (1..=10).map(|v| if v > 5 { -f64::from(v) } else { f64::from(v) }).collect();
+        assert!(signed_rank_p(&half) > 0.9);
+    }
+
+    #[test]
+    fn a_gain_every_block_shows_is_significant_however_uneven() {
+        // Drops of 1 to 10⁹ (t ≈ 1.3): the t test misses it, the signed-rank test does not.
+        let n = 1000;
+        let y = vec![0.0; n];
+        let after = vec![0.01; n];
+        let before: Vec<f64> = (0..n).map(|i| 0.01 + 10f64.powi((i / 100) as i32)).collect();
+        let rows: Vec<usize> = (0..n).collect();
+        let t = test(&y, &before, &after, &rows);
+        assert!(t.t < T_MIN && t.p_rank < P_RANK_MAX && t.significant, "{t:?}");
     }
 }
