@@ -19,6 +19,8 @@ fn the_sets_do_not_share_seeds_and_cover_everything() {
     let dev: Vec<u64> = cases(Set::Development, 300, 60).iter().map(|c| c.seed).collect();
     let held = cases(Set::Heldout, 300, 60);
     assert!(held.iter().all(|c| !dev.contains(&c.seed)));
+    let fresh = cases(Set::Fresh, 300, 60);
+    assert!(fresh.iter().all(|c| !dev.contains(&c.seed) && !held.iter().any(|h| h.seed == c.seed)));
     for (e, _) in EFFECTS {
         for x in EXCITATIONS {
             assert!(held.iter().any(|c| c.effect == *e && c.excitation == *x), "{e} {x}");
