@@ -100,13 +100,7 @@ fn centred(v: &[f64]) -> Vec<f64> {
 /// delay (forward and backward first-order low-pass, 0.25 s). 0 where the input rests.
 fn local_frequency(x: &[f64], dx: &[f64], dt: f64) -> Vec<f64> {
     const SMOOTH_S: f64 = 0.25;
-    let zero_phase = |v: &[f64]| -> Vec<f64> {
-        let mut f = lowpass(v, SMOOTH_S, dt);
-        f.reverse();
-        let mut b = lowpass(&f, SMOOTH_S, dt);
-        b.reverse();
-        b
-    };
+    let zero_phase = |v: &[f64]| crate::numerics::derivative::filtfilt(v, SMOOTH_S / dt);
     let level = zero_phase(x);
     let dev: Vec<f64> = x.iter().zip(&level).map(|(x, m)| (x - m) * (x - m)).collect();
     let (p_x, p_dx) = (zero_phase(&dev), zero_phase(&dx.iter().map(|d| d * d).collect::<Vec<f64>>()));
