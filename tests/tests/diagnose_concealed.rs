@@ -12,10 +12,12 @@
 //! - [`bench_table`] (ignored, about 25 minutes): the full table, per effect and per
 //!   excitation: `BENCH_SET=heldout cargo test --release -p integration-tests --test
 //!   diagnose_concealed -- --ignored --nocapture` (`BENCH_SET=dev` for the development
-//!   seeds, `fresh` for the second held-out range; `BENCH_N`, `BENCH_NULL` for the number of
+//!   seeds, `fresh` and `fresh2` for the second and third held-out ranges; `BENCH_N`, `BENCH_NULL` for the number of
 //!   effect and null cases, default 256 and 48; `BENCH_MIN_FS`, `BENCH_MAX_FS` keep only the
 //!   cases sampled within those rates, Hz). It prints one line per case and writes
-//!   `target/bench_<set>.md`.
+//!   `target/bench_<set>.md`; `BENCH_DUMP=FILE` appends a JSON line per case (the case,
+//!   the findings, every candidate tested with its statistics) for studying a decision rule
+//!   offline.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -34,6 +36,8 @@ struct Outcome {
     round1: Vec<String>,
     base: String,
     seconds: f64,
+    /// The diagnosis' base, notes and every candidate tested (for `BENCH_DUMP`).
+    json: serde_json::Value,
 }
 
 impl Outcome {
@@ -52,10 +56,10 @@ fn run(c: &Case) -> Outcome {
     let (rec, data) = (&prepared.recording, &prepared.data);
     let aux = rec.auxiliary_channels(&ch);
     let opts = DiagnoseOptions::default();
-    let (found, round1, base, seconds) = match diagnose(data, aux, None, ("b", "torque"), &opts, &NoProgress) {
-        Ok(d) => (
-            d.findings.iter().map(|f| f.effect.clone()).collect(),
-            d.candidates
+    let (found, round1, base, seconds, json) = match diagnose(data, aux, None, ("b", "torque"), &opts, &NoProgress) {
+        Ok(d) => {
+            let round1 = d
+                .candidates
                 .iter()
                 .filter(|t| t.round == 1)
                 .map(|t| {
@@ -68,13 +72,16 @@ fn run(c: &Case) -> Outcome {
                         t.impossible.as_deref().map(|w| format!(" ({w})")).unwrap_or_default()
                     )
                 })
-                .collect(),
-            d.base_model,
-            d.seconds,
-        ),
-        Err(e) => (vec![format!("error: {e}")], Vec::new(), String::new(), 0.0),
+                .collect();
+            let json = serde_json::json!({
+                "base": d.base_model, "bases_tried": d.bases_tried, "noise_rms": d.locate.noise_rms,
+                "notes": d.notes, "candidates": d.candidates,
+            });
+            (d.findings.iter().map(|f| f.effect.clone()).collect(), round1, d.base_model, d.seconds, json)
+        }
+        Err(e) => (vec![format!("error: {e}")], Vec::new(), String::new(), 0.0, serde_json::Value::Null),
     };
-    Outcome { case: c.clone(), form: g.label.form, found, round1, base, seconds }
+    Outcome { case: c.clone(), form: g.label.form, found, round1, base, seconds, json }
 }
 
 fn line(o: &Outcome) -> String {
@@ -168,6 +175,12 @@ fn run_all(cases: &[Case]) -> Vec<Outcome> {
         .map(|c| {
             let o = run(c);
             println!("{}", line(&o));
+            if let Ok(path) = std::env::var("BENCH_DUMP") {
+                use std::io::Write;
+                let rec = serde_json::json!({"case": o.case, "form": o.form, "found": o.found, "diagnosis": o.json});
+                let mut f = std::fs::OpenOptions::new().create(true).append(true).open(path).expect("BENCH_DUMP");
+                writeln!(f, "{rec}").expect("BENCH_DUMP");
+            }
             if !o.right() && std::env::var("BENCH_VERBOSE").is_ok() {
                 println!("      round 1: {}", o.round1.join("; "));
             }
@@ -199,11 +212,12 @@ fn blind_subset_of_heldout_seeds() {
 }
 
 #[test]
-#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|dev, BENCH_N, BENCH_NULL"]
+#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
     let set = match std::env::var("BENCH_SET").as_deref() {
         Ok("dev") => Set::Development,
         Ok("fresh") => Set::Fresh,
+        Ok("fresh2") => Set::Fresh2,
         _ => Set::Heldout,
     };
     let n = std::env::var("BENCH_N").ok().and_then(|v| v.parse().ok()).unwrap_or(256);
@@ -224,6 +238,7 @@ fn bench_table() {
     let name = match set {
         Set::Heldout => "bench_heldout.md",
         Set::Fresh => "bench_fresh.md",
+        Set::Fresh2 => "bench_fresh2.md",
         Set::Development => "bench_dev.md",
     };
     let body: Vec<String> = outcomes.iter().map(line).collect();

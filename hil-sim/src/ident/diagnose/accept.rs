@@ -59,7 +59,8 @@ impl Judge<'_> {
             let change = (self.rows.iter().map(|&i| (f.pred[i] - reference.pred[i]).powi(2)).sum::<f64>()
                 / self.rows.len().max(1) as f64)
                 .sqrt();
-            let resolvable = change >= significance::MIN_TERM_OF_NOISE * self.noise_rms;
+            let change_of_noise = change / self.noise_rms.max(1e-300);
+            let resolvable = change_of_noise >= significance::MIN_TERM_OF_NOISE;
             let impossible = super::physical::impossible(c, f, reference.terms.len(), s.value);
             let eligible = impossible.is_none()
                 && s.bic_gain > 0.0
@@ -75,6 +76,7 @@ impl Judge<'_> {
                 heldout_r_rmse_before: before.r_rmse,
                 heldout_r_rmse_after: after.r_rmse,
                 test,
+                change_of_noise,
                 kept: false,
                 impossible,
             });

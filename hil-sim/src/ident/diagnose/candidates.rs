@@ -329,13 +329,15 @@ fn input_transforms(s: &InputStats) -> Vec<Candidate> {
 
 /// Rate dependence in three shapes (`c·|ẋ|ẋ`, `c·ẋ³`, and a damping that grows with the
 /// local excitation frequency, `c·(f_loc/f̄ − 1)·ẋ`: the catalog's α(f), beyond the linear
-/// `c·ẋ` a base already has), direction (`δ·(x − x̄)·sgn(ẋ)`, the sign smoothed over 5 % of
-/// the rate's spread) and inertia (`m·ẍ`, from a measured acceleration when there is one).
+/// `c·ẋ` a base already has), direction in two shapes (`δ·(x − x̄)·sgn(ẋ)` and
+/// `δ₂·(x − x̄)²·sgn(ẋ)`, the sign smoothed over 5 % of the rate's spread) and inertia (`m·ẍ`, from a measured acceleration when there is one).
 fn kinematic_terms(s: &InputStats, aux: &[AuxChannel]) -> Vec<Candidate> {
     let rate_term: Vec<f64> = s.dx.iter().map(|v| v.abs() * v).collect();
     let cubed: Vec<f64> = s.dx.iter().map(|v| v * v * v).collect();
     let by_frequency: Vec<f64> = local_frequency(&s.x, &s.dx, s.dt).iter().zip(&s.dx).map(|(f, d)| f * d).collect();
-    let asym: Vec<f64> = s.x.iter().zip(&s.dx).map(|(x, d)| (x - s.x_mean) * (d / (0.05 * s.dx_std)).tanh()).collect();
+    let direction: Vec<f64> = s.dx.iter().map(|d| (d / (0.05 * s.dx_std)).tanh()).collect();
+    let asym: Vec<f64> = s.x.iter().zip(&direction).map(|(x, d)| (x - s.x_mean) * d).collect();
+    let asym2: Vec<f64> = s.x.iter().zip(&direction).map(|(x, d)| (x - s.x_mean).powi(2) * d).collect();
     let acc = aux.iter().find(|a| a.role == Role::InputAcceleration);
     let (acc_values, acc_label, acc_channel) = match acc {
         Some(a) => {
@@ -354,6 +356,13 @@ fn kinematic_terms(s: &InputStats, aux: &[AuxChannel]) -> Vec<Candidate> {
             None,
         ),
         additive("asymmetry", "loading/unloading difference growing with the input".into(), "delta", asym, None),
+        additive(
+            "asymmetry",
+            "loading/unloading difference growing with the input squared".into(),
+            "delta2",
+            asym2,
+            None,
+        ),
         additive("inertia", acc_label, "m", acc_values, acc_channel),
     ]
 }

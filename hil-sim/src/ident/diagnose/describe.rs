@@ -193,6 +193,10 @@ fn what(d: &Described<'_>) -> String {
             "the loop changes with the excitation rate beyond the model's linear rate term (a |rate|·rate term, coefficient {} per ({xu}/s)²)",
             with_unit(coef, &yu)
         ),
+        "asymmetry" if c.label.contains("squared") => format!(
+            "loading and unloading differ by an amount growing with the square of the {i} (δ₂ = {} per ({xu})²)",
+            with_unit(coef, &yu)
+        ),
         "asymmetry" => {
             format!("loading and unloading differ by an amount growing with the {i} (δ = {} per {xu})", with_unit(coef, &yu))
         }
@@ -243,6 +247,7 @@ fn coefficient_unit(name: &str, (i, o): (&str, &str), ch: Option<&str>) -> Optio
         "c_rate3" => format!("{yu} per ({xu}/s)³"),
         "c_freq" => format!("{yu} per ({xu}/s)"),
         "delta" | "k_input" => format!("{yu} per {xu}"),
+        "delta2" => format!("{yu} per ({xu})²"),
         "m" if ch.is_some() => format!("{yu} per ({cu})"),
         "m" => format!("{yu} per ({xu}/s²)"),
         "j" if yu == "N·m" && cu == "rad/s" => "kg·m²".to_owned(),

@@ -62,6 +62,9 @@ pub struct Tested {
     pub heldout_r_rmse_before: f64,
     pub heldout_r_rmse_after: f64,
     pub test: Test,
+    /// RMS of what the term changes in the prediction, in units of the residual's noise
+    /// floor (below [`super::significance::MIN_TERM_OF_NOISE`] the recording does not resolve it).
+    pub change_of_noise: f64,
     pub kept: bool,
     /// Why its fitted values are physically impossible (then it is never kept).
     #[serde(skip_serializing_if = "Option::is_none")]

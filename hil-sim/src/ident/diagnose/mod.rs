@@ -5,7 +5,10 @@
 //! 1. **Base** ([`base`]). The base model is fitted on the training part (the first
 //!    `1 − heldout_fraction`) with the channels as recorded (no delay fitted: a time shift
 //!    between channels is a finding, not something to absorb silently). `auto` fits every
-//!    seed model ([`AUTO_BASES`]) and keeps the best held-out one.
+//!    seed model ([`AUTO_BASES`]) and keeps the best held-out one. A static power-law term of
+//!    the input ([`level_map`]: the torque growing faster than linearly with the field) joins
+//!    the base when it helps, with a note: a curvature the base family lacks is not physics
+//!    left out.
 //! 2. **Locate** ([`locate`]). The base residual's energy over time (windows), over the
 //!    operating space (input level, |rate|, direction, auxiliary channels) and over
 //!    frequency; its sample-to-sample noise floor.
@@ -33,6 +36,7 @@ pub mod decimate;
 pub mod describe;
 pub mod diagnosis;
 pub mod leak;
+pub mod level_map;
 pub mod locate;
 pub mod options;
 pub mod physical;
@@ -141,6 +145,15 @@ fn diagnose_at_rate(
     let mut used: Vec<usize> = Vec::new();
     let y_span = span_on(&data.output, &held);
     let mut notes = base.failed.clone();
+    // The field-to-torque curvature a linear base misses is part of the base, not a finding.
+    if let Some((with_map, p)) = level_map::fit(&prob, &current, |pred| judge.heldout(pred).rmse) {
+        notes.push(format!(
+            "the base model {id} was given a static term in the {} to the power {p:.2}: the {} grows faster than \
+             linearly with it, and every candidate was judged on top of that term",
+            names.0, names.1
+        ));
+        current = with_map;
+    }
     // Joins of a dataset's runs, with any the caller gave: a finding sitting on one says so.
     let boundaries: Vec<usize> =
         opts.boundaries.iter().copied().chain(data.run_starts().into_iter().filter(|&s| s > 0)).collect();

@@ -23,7 +23,7 @@ pub const BLOCKS: usize = 10;
 /// Smallest t statistic of the mean per-block drop in squared error.
 pub const T_MIN: f64 = 3.0;
 /// Smallest relative drop of the held-out RMSE.
-pub const MIN_GAIN: f64 = 0.02;
+pub const MIN_GAIN: f64 = 0.03;
 /// Smallest RMS change of the prediction, in units of the residual's noise floor.
 pub const MIN_TERM_OF_NOISE: f64 = 0.75;
 /// Largest one-sided p of the signed-rank test that counts as significant on its own

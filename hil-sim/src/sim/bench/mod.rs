@@ -23,9 +23,9 @@
 //! second-order Butterworth run both ways, corner 100–400 Hz, below 0.2·fs) on the field
 //! and the torque.
 //!
-//! The seeds are split: [`Set::Development`] draws from one range, [`Set::Heldout`] and
-//! [`Set::Fresh`] from two others; the method is developed on the first and reported on
-//! the others.
+//! The seeds are split: [`Set::Development`] draws from one range, [`Set::Heldout`],
+//! [`Set::Fresh`] and [`Set::Fresh2`] from three others; the method is developed on the
+//! first and reported on the others (each first run for one report).
 
 pub mod chain;
 pub mod effects;
@@ -58,6 +58,8 @@ pub enum Set {
     /// A second held-out range, first run for the report of 2026-11-24 (the first held-out
     /// set had been reported on once before).
     Fresh,
+    /// A third held-out range, first run for the report of 2026-11-25.
+    Fresh2,
 }
 
 impl Set {
@@ -67,6 +69,7 @@ impl Set {
             Set::Development => 10_000 + k,
             Set::Heldout => 7_300_000 + 7 * k,
             Set::Fresh => 9_100_000 + 11 * k,
+            Set::Fresh2 => 12_700_000 + 13 * k,
         }
     }
 }

@@ -21,6 +21,10 @@ fn the_sets_do_not_share_seeds_and_cover_everything() {
     assert!(held.iter().all(|c| !dev.contains(&c.seed)));
     let fresh = cases(Set::Fresh, 300, 60);
     assert!(fresh.iter().all(|c| !dev.contains(&c.seed) && !held.iter().any(|h| h.seed == c.seed)));
+    let fresh2 = cases(Set::Fresh2, 300, 60);
+    assert!(fresh2.iter().all(|c| !dev.contains(&c.seed)
+        && !held.iter().any(|h| h.seed == c.seed)
+        && !fresh.iter().any(|f| f.seed == c.seed)));
     for (e, _) in EFFECTS {
         for x in EXCITATIONS {
             assert!(held.iter().any(|c| c.effect == *e && c.excitation == *x), "{e} {x}");
