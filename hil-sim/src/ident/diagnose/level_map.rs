@@ -42,44 +42,25 @@ pub fn fit(prob: &Problem<'_>, current: &Fitted, heldout_rmse: impl Fn(&[f64]) -
     (bic_gain > 0.0 && better && beta > 0.0).then_some((with_map, p))
 }
 
+/// The note a diagnosis carries when the base `id` got the level term of exponent `p`
+/// (`names`: the input's and the output's).
+pub fn note(id: &str, (input, output): (&str, &str), p: f64) -> String {
+    format!(
+        "the base model {id} was given a static term in the {input} to the power {p:.2}: the {output} grows faster \
+         than linearly with it, and every candidate was judged on top of that term"
+    )
+}
+
 #[cfg(test)]
 mod tests {
+    use crate::ident::diagnose::tests::recording_with;
     use crate::ident::diagnose::{diagnose, DiagnoseOptions, InputTransform};
     use crate::ident::fit::Dataset;
-    use crate::models::RateSpec;
-    use rand::{Rng, SeedableRng};
 
-    /// A Bouc–Wen recording (model-core's, a three-tone input, 0.5 % noise) whose model is fed
-    /// the input through `seen` and whose torque gets `extra(x)` on top.
-    fn recording(seen: Option<InputTransform>, extra: impl Fn(f64) -> f64, seed: u64) -> Dataset {
-        let (dt, n) = (1e-3, 12_000);
-        let time: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
-        let tone = |t: f64, f: f64, a: f64, ph: f64| a * (2.0 * std::f64::consts::PI * f * t + ph).sin();
-        let x: Vec<f64> = time
-            .iter()
-            .map(|&t| 1.0 + 0.6 * tone(t, 2.0, 1.0, 0.0) + tone(t, 7.3, 0.3, 1.0) + tone(t, 13.1, 0.1, 2.0))
-            .collect();
-        let fed = seen.map_or_else(|| x.clone(), |s| s.apply(&x, dt));
-        let rates = crate::numerics::derivative::rates(&fed, dt);
-        let samples = crate::models::replay::samples_with_rates(&fed, None, Some(&rates));
-        let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
-        let out = crate::models::replay("bouc_wen", &truth, dt as f32, RateSpec::Backward, &samples).unwrap();
-        let y: Vec<f64> = out.y.iter().zip(&x).map(|(v, x)| f64::from(*v) + extra(*x)).collect();
-        let (lo, hi) = y.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
-        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-        let output = y.iter().map(|v| v + 0.005 * (hi - lo) * (rng.random::<f64>() - 0.5) * 12f64.sqrt()).collect();
-        Dataset {
-            dt,
-            time,
-            input: x,
-            output,
-            command: None,
-            train_end: 8400,
-            excluded: vec![false; n],
-            unusable: Vec::new(),
-            rates: None,
-            runs: Vec::new(),
-        }
+    /// A unipolar three-tone field, 0.3–1.7.
+    fn field(t: f64) -> f64 {
+        let tone = |f: f64, a: f64, ph: f64| a * (2.0 * std::f64::consts::PI * f * t + ph).sin();
+        1.0 + tone(2.0, 0.6, 0.0) + tone(7.3, 0.3, 1.0) + tone(13.1, 0.1, 2.0)
     }
 
     fn notes_and_findings(d: &Dataset) -> (Vec<String>, Vec<String>) {
@@ -91,7 +72,7 @@ mod tests {
     #[test]
     fn a_torque_growing_faster_than_the_field_is_part_of_the_base_not_a_finding() {
         // 1.5·x^1.7 on a field of 0.3–1.7: about a third of the torque's span.
-        let (notes, findings) = notes_and_findings(&recording(None, |x| 1.5 * x.abs().powf(1.7), 3));
+        let (notes, findings) = notes_and_findings(&recording_with(field, None, |x| 1.5 * x.abs().powf(1.7), 3));
         assert!(notes.iter().any(|n| n.contains("to the power")), "{notes:?}");
         assert!(findings.is_empty(), "{findings:?}");
     }
@@ -99,7 +80,7 @@ mod tests {
     #[test]
     fn a_saturating_field_is_not_taken_for_a_level_term() {
         let sat = InputTransform::Saturate { b_sat: 1.2 };
-        let (notes, findings) = notes_and_findings(&recording(Some(sat), |_| 0.0, 4));
+        let (notes, findings) = notes_and_findings(&recording_with(field, Some(sat), |_| 0.0, 4));
         assert!(!notes.iter().any(|n| n.contains("to the power")), "{notes:?}");
         assert_eq!(findings.first().map(String::as_str), Some("saturation"), "{findings:?}");
     }

@@ -133,25 +133,17 @@ fn diagnose_at_rate(
     let located = locate::residual(data, &base.fit.output, &all_rows, &dx, &aux_refs, base_heldout.rmse);
     judge.noise_rms = located.noise_rms;
     progress.advance(1);
-
     // 3–4. Name and model, round by round.
     let cands = candidates::all(data, &channels, unit_of(names.0) == Some("T"));
     // The base as the refits see it: Gauss–Newton run on from the fit until it stalls, so
     // that a term is never credited with what more iterations of the base would have done.
     let diverges = || DiagnoseError::Diverges(id.clone());
     let mut current = prob.refit(&[], &[], None, &base.fit.flat, BASE_ITERATIONS).map(|r| r.0).ok_or_else(diverges)?;
-    let mut findings = Vec::new();
-    let mut tested = Vec::new();
-    let mut used: Vec<usize> = Vec::new();
+    let (mut findings, mut tested, mut used) = (Vec::new(), Vec::new(), Vec::<usize>::new());
     let y_span = span_on(&data.output, &held);
     let mut notes = base.failed.clone();
-    // The field-to-torque curvature a linear base misses is part of the base, not a finding.
     if let Some((with_map, p)) = level_map::fit(&prob, &current, |pred| judge.heldout(pred).rmse) {
-        notes.push(format!(
-            "the base model {id} was given a static term in the {} to the power {p:.2}: the {} grows faster than \
-             linearly with it, and every candidate was judged on top of that term",
-            names.0, names.1
-        ));
+        notes.push(level_map::note(&id, names, p));
         current = with_map;
     }
     // Joins of a dataset's runs, with any the caller gave: a finding sitting on one says so.
@@ -194,8 +186,7 @@ fn diagnose_at_rate(
             boundaries: &boundaries,
             runner_up,
         }));
-        used.push(kept.scored.index);
-        // A candidate of the same effect on the same channel is not tested again.
+        // Neither it nor a candidate of the same effect on the same channel is tested again.
         used.extend((0..cands.len()).filter(|&j| cands[j].effect == c.effect && cands[j].channel == c.channel));
         current = kept.scored.fitted;
     }
@@ -241,28 +232,35 @@ mod tests {
     use crate::models::RateSpec;
     use rand::{Rng, SeedableRng};
 
-    /// A bouc_wen recording of a two-tone input; the model is fed the input through
+    /// A bouc_wen recording of a three-tone input; the model is fed the input through
     /// `effect` and the output gets white noise of 0.5 % of its span.
     fn recording(effect: Option<Transform>, seed: u64) -> Dataset {
+        let tone = |t: f64, f: f64, ph: f64| (2.0 * std::f64::consts::PI * f * t + ph).sin();
+        let x = |t: f64| tone(t, 2.0, 0.0) + 0.5 * tone(t, 7.3, 1.0) + 0.25 * tone(t, 13.1, 2.0);
+        recording_with(x, effect, |_| 0.0, seed)
+    }
+
+    /// 12 s at 1 kHz of model-core's Bouc–Wen fed the input `x(t)` through `effect`, with
+    /// `extra(x)` added to its output and white noise of 0.5 % of the output's span; the
+    /// first 70 % trains.
+    pub(super) fn recording_with(
+        x: impl Fn(f64) -> f64,
+        effect: Option<Transform>,
+        extra: impl Fn(f64) -> f64,
+        seed: u64,
+    ) -> Dataset {
         let dt = 1e-3;
         let n = 12_000;
         let time: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
         let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-        let x: Vec<f64> = time
-            .iter()
-            .map(|t| {
-                (2.0 * std::f64::consts::PI * 2.0 * t).sin()
-                    + 0.5 * (2.0 * std::f64::consts::PI * 7.3 * t + 1.0).sin()
-                    + 0.25 * (2.0 * std::f64::consts::PI * 13.1 * t + 2.0).sin()
-            })
-            .collect();
+        let x: Vec<f64> = time.iter().map(|&t| x(t)).collect();
         let seen = effect.map_or_else(|| x.clone(), |e| e.apply(&x, dt));
         // The clutch's physics sees the true rate (here the zero-phase one of the clean input).
         let rates = crate::numerics::derivative::rates(&seen, dt);
         let samples = crate::models::replay::samples_with_rates(&seen, None, Some(&rates));
         let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
         let out = crate::models::replay("bouc_wen", &truth, dt as f32, RateSpec::Backward, &samples).unwrap();
-        let y: Vec<f64> = out.y.iter().map(|v| f64::from(*v)).collect();
+        let y: Vec<f64> = out.y.iter().zip(&x).map(|(v, x)| f64::from(*v) + extra(*x)).collect();
         let (lo, hi) = y.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
         let noise = 0.005 * (hi - lo);
         let output = y.iter().map(|v| v + noise * (rng.random::<f64>() - 0.5) * 12f64.sqrt()).collect();
