@@ -214,12 +214,9 @@ fn blind_subset_of_heldout_seeds() {
 #[test]
 #[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
-    let set = match std::env::var("BENCH_SET").as_deref() {
-        Ok("dev") => Set::Development,
-        Ok("fresh") => Set::Fresh,
-        Ok("fresh2") => Set::Fresh2,
-        _ => Set::Heldout,
-    };
+    let sets = [("dev", Set::Development), ("heldout", Set::Heldout), ("fresh", Set::Fresh), ("fresh2", Set::Fresh2)];
+    let key = std::env::var("BENCH_SET").ok();
+    let (key, set) = sets.into_iter().find(|(k, _)| key.as_deref() == Some(*k)).unwrap_or(sets[1]);
     let n = std::env::var("BENCH_N").ok().and_then(|v| v.parse().ok()).unwrap_or(256);
     let n_null = std::env::var("BENCH_NULL").ok().and_then(|v| v.parse().ok()).unwrap_or(48);
     // BENCH_FROM / BENCH_TO: a slice of the list (to share a run between processes).
@@ -235,12 +232,6 @@ fn bench_table() {
     println!("named first {:.1} %, worst effect {:.1} %, false alarms {alarms}", 100.0 * all, 100.0 * worst);
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target");
     let _ = std::fs::create_dir_all(&dir);
-    let name = match set {
-        Set::Heldout => "bench_heldout.md",
-        Set::Fresh => "bench_fresh.md",
-        Set::Fresh2 => "bench_fresh2.md",
-        Set::Development => "bench_dev.md",
-    };
     let body: Vec<String> = outcomes.iter().map(line).collect();
-    let _ = std::fs::write(dir.join(name), format!("{t}\n```\n{}\n```\n", body.join("\n")));
+    let _ = std::fs::write(dir.join(format!("bench_{key}.md")), format!("{t}\n```\n{}\n```\n", body.join("\n")));
 }

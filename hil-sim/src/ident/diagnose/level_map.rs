@@ -35,9 +35,9 @@ pub fn fit(prob: &Problem<'_>, current: &Fitted, heldout_rmse: impl Fn(&[f64]) -
     let tune = Tune { build: &build, start: 1.5, lo: P_MIN, hi: P_MAX, log: false };
     let (with_map, p) = prob.refit(&current.transforms, &current.terms, Some(&tune), &current.theta, ITERATIONS)?;
     let beta = with_map.beta.get(current.terms.len()).copied().unwrap_or(0.0);
-    let n = prob.train.len() as f64;
-    // Two extra parameters: β and p.
-    let bic_gain = n * (reference.train_mse.max(1e-300) / with_map.train_mse.max(1e-300)).ln() - 2.0 * n.ln();
+    // The term's β is counted by the criterion; its exponent p is one more parameter.
+    let n = prob.train.len();
+    let bic_gain = super::rank::bic(n, &reference) - super::rank::bic(n, &with_map) - (n as f64).ln();
     let better = heldout_rmse(&with_map.pred) < heldout_rmse(&reference.pred);
     (bic_gain > 0.0 && better && beta > 0.0).then_some((with_map, p))
 }

@@ -29,6 +29,13 @@ pub struct Scored {
     pub value: f64,
 }
 
+/// The Bayesian information criterion of `f` on `n_train` training rows, counting the
+/// coefficients it adds to the base model: `n·ln(MSE) + k·ln(n)`.
+pub fn bic(n_train: usize, f: &Fitted) -> f64 {
+    let n = n_train as f64;
+    n * f.train_mse.max(1e-300).ln() + (f.extra_params() as f64) * n.ln()
+}
+
 /// The reference of a round: `current` refitted with as many iterations as a polished
 /// candidate gets (`None` if it diverges).
 pub fn reference(prob: &Problem<'_>, current: &Fitted) -> Option<Fitted> {
@@ -40,8 +47,7 @@ pub fn reference(prob: &Problem<'_>, current: &Fitted) -> Option<Fitted> {
 /// BIC gain, best first; `None` when the base model's Jacobian cannot be taken.
 pub fn rank(prob: &Problem<'_>, cands: &[Candidate], reference: &Fitted, used: &[usize]) -> Option<Vec<Scored>> {
     let jac = prob.jacobian_at(&reference.theta, &reference.transforms)?;
-    let ntr = prob.train.len() as f64;
-    let bic = |f: &Fitted| ntr * f.train_mse.max(1e-300).ln() + (f.extra_params() as f64) * ntr.ln();
+    let bic = |f: &Fitted| bic(prob.train.len(), f);
     let bic_ref = bic(reference);
     let mut scored: Vec<Scored> = cands
         .par_iter()
