@@ -12,7 +12,7 @@
 //! - [`bench_table`] (ignored, about 25 minutes): the full table, per effect and per
 //!   excitation: `BENCH_SET=heldout cargo test --release -p integration-tests --test
 //!   diagnose_concealed -- --ignored --nocapture` (`BENCH_SET=dev` for the development
-//!   seeds, `fresh` and `fresh2` for the second and third held-out ranges; `BENCH_N`, `BENCH_NULL` for the number of
+//!   seeds, `fresh`, `fresh2` and `fresh3` for the second, third and fourth held-out ranges; `BENCH_N`, `BENCH_NULL` for the number of
 //!   effect and null cases, default 256 and 48; `BENCH_MIN_FS`, `BENCH_MAX_FS` keep only the
 //!   cases sampled within those rates, Hz). It prints one line per case and writes
 //!   `target/bench_<set>.md`; `BENCH_DUMP=FILE` appends a JSON line per case (the case,
@@ -212,9 +212,15 @@ fn blind_subset_of_heldout_seeds() {
 }
 
 #[test]
-#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2|dev, BENCH_N, BENCH_NULL"]
+#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2|fresh3|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
-    let sets = [("dev", Set::Development), ("heldout", Set::Heldout), ("fresh", Set::Fresh), ("fresh2", Set::Fresh2)];
+    let sets = [
+        ("dev", Set::Development),
+        ("heldout", Set::Heldout),
+        ("fresh", Set::Fresh),
+        ("fresh2", Set::Fresh2),
+        ("fresh3", Set::Fresh3),
+    ];
     let key = std::env::var("BENCH_SET").ok();
     let (key, set) = sets.into_iter().find(|(k, _)| key.as_deref() == Some(*k)).unwrap_or(sets[1]);
     let n = std::env::var("BENCH_N").ok().and_then(|v| v.parse().ok()).unwrap_or(256);

@@ -18,6 +18,8 @@ pub struct Judge<'a> {
     pub held: &'a [usize],
     pub rows: &'a [usize],
     pub noise_rms: f64,
+    /// The sample interval, s.
+    pub dt: f64,
 }
 
 /// The candidate kept in a round.
@@ -61,7 +63,7 @@ impl Judge<'_> {
                 .sqrt();
             let change_of_noise = change / self.noise_rms.max(1e-300);
             let resolvable = change_of_noise >= significance::MIN_TERM_OF_NOISE;
-            let impossible = super::physical::impossible(c, f, reference.terms.len(), s.value);
+            let impossible = super::physical::impossible(c, f, reference.terms.len(), s.value, self.dt);
             let eligible = impossible.is_none()
                 && s.bic_gain > 0.0
                 && f.train_mse < reference.train_mse

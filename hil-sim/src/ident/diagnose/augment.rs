@@ -33,6 +33,9 @@ pub enum Transform {
     Delay { delay_s: f64 },
     /// First-order lag `τ·ẋ_f = x − x_f` (Spencer's η filter with η = 1/τ).
     Lag { tau_s: f64 },
+    /// Two first-order lags of `τ/2` each in series (a field diffusing through two layers:
+    /// its step response starts flat, between a first-order lag and a delay).
+    Lag2 { tau_s: f64 },
     /// `b_s · tanh(x / b_s)`.
     Saturate { b_sat: f64 },
     /// The recorded input reads `b_0` high: the model sees `x − b_0`.
@@ -53,6 +56,10 @@ impl Transform {
                         f
                     })
                     .collect()
+            }
+            Self::Lag2 { tau_s } => {
+                let half = Self::Lag { tau_s: 0.5 * tau_s };
+                half.apply(&half.apply(x, dt), dt)
             }
             Self::Saturate { b_sat } => x.iter().map(|v| b_sat * (v / b_sat).tanh()).collect(),
             Self::Offset { b_0 } => x.iter().map(|v| v - b_0).collect(),

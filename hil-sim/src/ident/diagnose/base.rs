@@ -32,15 +32,24 @@ const LM_ITERATIONS: usize = 30;
 /// scores: delays and filters read past the ends.
 const MARGIN_S: f64 = 0.02;
 
-/// The fitted base model and what its refits need.
+/// A fitted base model and what its refits need.
 pub struct Base {
     pub fit: FitResult,
+    pub sim: Box<dyn Simulator>,
+    pub spec: ModelSpec,
+}
+
+/// Every base model fitted, the contenders among them and what failed.
+pub struct Bases {
+    /// The contenders ([`super::contenders::pick`]), the best held-out one first.
+    pub contenders: Vec<Base>,
+    /// With `auto`: the seed model that is also tried with play operators
+    /// ([`super::contenders::PLAY_HOST`]), when it could be fitted.
+    pub play_host: Option<Base>,
     /// Every base model fitted, with its held-out R-RMSE.
     pub tried: Vec<(String, f64)>,
     /// The base models `auto` could not fit, with why.
     pub failed: Vec<String>,
-    pub sim: Box<dyn Simulator>,
-    pub spec: ModelSpec,
 }
 
 /// The base models to try: the one asked for, or [`AUTO_BASES`].
@@ -51,13 +60,14 @@ pub fn choices(opts: &DiagnoseOptions) -> Vec<&str> {
     }
 }
 
-/// Fit every base of `bases` (one progress step each) and keep the best held-out one.
-pub fn fit_base(
+/// Fit every base of `bases` (one progress step each); the best held-out one and the other
+/// contenders ([`super::contenders::pick`]) are made ready for the refits.
+pub fn fit_bases(
     data: &Dataset,
     bases: &[&str],
     opts: &DiagnoseOptions,
     progress: &dyn Progress,
-) -> Result<Base, DiagnoseError> {
+) -> Result<Bases, DiagnoseError> {
     let fit_opts = FitOptions {
         rate: opts.rate,
         delay: DelayChoice::Off,
@@ -82,21 +92,39 @@ pub fn fit_base(
     for r in fits.iter().filter(|r| !score(r).is_finite()) {
         errors.push(format!("the base model {} was fitted but its held-out prediction is not finite", r.model));
     }
-    let best = fits
-        .into_iter()
-        .filter(|r| score(r).is_finite())
-        .min_by(|a, b| score(a).total_cmp(&score(b)))
-        .ok_or_else(|| DiagnoseError::NoBase(errors.join("; ")))?;
-    let id = best.model.clone();
+    let mut fits: Vec<FitResult> = fits.into_iter().filter(|r| score(r).is_finite()).collect();
+    fits.sort_by(|a, b| score(a).total_cmp(&score(b)));
+    if fits.is_empty() {
+        return Err(DiagnoseError::NoBase(errors.join("; ")));
+    }
+    let scored: Vec<(&str, f64)> = fits.iter().map(|r| (r.model.as_str(), score(r))).collect();
+    let keep = super::contenders::pick(&scored);
+    let host = fits.iter().find(|r| opts.model.is_none() && r.model == super::contenders::PLAY_HOST).cloned();
+    let play_host = host.and_then(|f| ready(data, f).ok());
+    let mut contenders = Vec::with_capacity(keep.len());
+    for (k, fit) in fits.into_iter().enumerate().filter(|(k, _)| keep.contains(k)) {
+        match ready(data, fit) {
+            Ok(b) => contenders.push(b),
+            // The best base must be refittable; another contender that is not is left out.
+            Err(e) if k == 0 => return Err(e),
+            Err(_) => {}
+        }
+    }
+    Ok(Bases { contenders, play_host, tried, failed: errors })
+}
+
+/// The simulator and search space of the fitted base `fit`.
+fn ready(data: &Dataset, fit: FitResult) -> Result<Base, DiagnoseError> {
+    let id = fit.model.clone();
     let sim = crate::ident::fit::simulate::simulator(&id, data.dt as f32)
         .ok_or_else(|| DiagnoseError::NotParametric(id.clone()))?;
     let spec = crate::models::host(&id)
-        .and_then(|h| h.spec(&data.scales(), Some(best.rate_choice)))
+        .and_then(|h| h.spec(&data.scales(), Some(fit.rate_choice)))
         .ok_or_else(|| DiagnoseError::NotParametric(id.clone()))?;
     if !matches!(spec.strategy, Strategy::Linear | Strategy::Local | Strategy::Global) {
         return Err(DiagnoseError::NotParametric(id));
     }
-    Ok(Base { fit: best, tried, failed: errors, sim, spec })
+    Ok(Base { fit, sim, spec })
 }
 
 /// The training and held-out (unflagged) rows away from the ends.

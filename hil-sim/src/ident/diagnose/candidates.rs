@@ -279,13 +279,13 @@ pub fn all(data: &Dataset, aux: &[AuxChannel], input_is_field: bool) -> Vec<Cand
     out
 }
 
-/// Phase (a first-order lag and a pure delay, 1 sample to 50 ms) and amplitude (a
+/// Phase (a first-order lag, a two-pole lag, 1 sample to 50 ms, and a pure delay, ±30 ms) and amplitude (a
 /// saturating map and a zero offset): transforms of the input the base model is fed.
 fn input_transforms(s: &InputStats) -> Vec<Candidate> {
     let dt = s.dt;
     let fs = 1.0 / dt;
-    // ±20 ms (at least 4 samples), in at most 40 steps each way.
-    let reach = (0.02 * fs).round().max(4.0);
+    // ±30 ms (at least 4 samples), in at most 40 steps each way.
+    let reach = (0.03 * fs).round().max(4.0);
     let stride = (reach / 40.0).ceil();
     let max_delay = (reach / stride).round();
     vec![
@@ -295,6 +295,14 @@ fn input_transforms(s: &InputStats) -> Vec<Candidate> {
             grid_name: Some("tau_s".into()),
             grid: log_grid(dt, (0.05f64).max(4.0 * dt), 14),
             build: Box::new(|tau| Piece { transform: Some(Transform::Lag { tau_s: tau }), terms: vec![] }),
+            channel: None,
+        },
+        Candidate {
+            effect: "field_lag",
+            label: "two-pole lag of the input".into(),
+            grid_name: Some("tau_s".into()),
+            grid: log_grid(2.0 * dt, (0.05f64).max(8.0 * dt), 14),
+            build: Box::new(|tau| Piece { transform: Some(Transform::Lag2 { tau_s: tau }), terms: vec![] }),
             channel: None,
         },
         Candidate {

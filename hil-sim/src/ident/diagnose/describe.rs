@@ -160,6 +160,11 @@ fn what(d: &Described<'_>) -> String {
     let coef2 = f.beta.get(d.reference.terms.len() + 1).copied().unwrap_or(0.0);
     let ch = c.channel.clone().unwrap_or_default();
     match c.effect {
+        "field_lag" if c.label.contains("two-pole") => format!(
+            "the {o} lags the {i} reading through two first-order lags of {:.2} ms each ({:.2} ms in all: a field diffusing through the discs, or eddy currents behind a coil lag)",
+            0.5e3 * g,
+            1e3 * g
+        ),
         "field_lag" => format!(
             "the {o} lags the {i} reading by a first-order lag of {:.2} ms (eddy currents, the fluid's chain-forming time, coil dynamics)",
             1e3 * g

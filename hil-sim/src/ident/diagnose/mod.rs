@@ -32,6 +32,7 @@ pub mod accept;
 pub mod augment;
 pub mod base;
 pub mod candidates;
+pub mod contenders;
 pub mod decimate;
 pub mod describe;
 pub mod diagnosis;
@@ -51,7 +52,7 @@ use std::time::Instant;
 use crate::ident::fit::Dataset;
 use crate::progress::Progress;
 use accept::Judge;
-use augment::{Problem, Transform};
+use augment::Transform;
 use candidates::Role;
 use describe::Described;
 
@@ -60,9 +61,6 @@ pub use describe::unit_of;
 pub use diagnosis::{Diagnosis, Evidence, Finding, PlotData, Tested};
 pub use locate::Locate;
 pub use options::{DiagnoseError, DiagnoseOptions};
-
-/// Levenberg–Marquardt iterations that converge the fitted base before the first round.
-const BASE_ITERATIONS: usize = 8;
 
 /// Diagnose `data` (its auxiliary channels `aux`: name and values; the command channel, if
 /// the model uses one, is named by `command`; `names` are the input's and the output's).
@@ -115,56 +113,55 @@ fn diagnose_at_rate(
     let data = &data;
     let bases = base::choices(opts);
     progress.stage("diagnosing", (bases.len() + 2 + 2 * opts.max_findings) as u64);
-    // 1. Base.
-    let base = base::fit_base(data, &bases, opts, progress)?;
-    let id = base.fit.model.clone();
+    // 1. Base: every seed model fitted; the structurally different ones close to the best
+    // get the first round each, and the one whose first round predicts best is kept.
+    let fitted = base::fit_bases(data, &bases, opts, progress)?;
     let (train, held) = base::rows(data);
-    let prob = Problem { data, sim: base.sim.as_ref(), spec: &base.spec, rate: base.fit.rate_choice, train };
-    let all_rows: Vec<usize> = prob.train.iter().chain(&held).copied().collect();
-
-    // 2. Locate.
+    let all_rows: Vec<usize> = train.iter().chain(&held).copied().collect();
     progress.message("locating");
     let channels = candidates::classify(data, aux, command);
     let (dx, _) = candidates::rates(data);
     let aux_refs: Vec<(&str, &[f64])> =
         channels.iter().filter(|c| c.role != Role::Unused).map(|c| (c.name.as_str(), c.values.as_slice())).collect();
-    let mut judge = Judge { y: &data.output, held: &held, rows: &all_rows, noise_rms: 0.0 };
-    let base_heldout = judge.heldout(&base.fit.output);
-    let located = locate::residual(data, &base.fit.output, &all_rows, &dx, &aux_refs, base_heldout.rmse);
-    judge.noise_rms = located.noise_rms;
-    progress.advance(1);
-    // 3–4. Name and model, round by round.
     let cands = candidates::all(data, &channels, unit_of(names.0) == Some("T"));
-    // The base as the refits see it: Gauss–Newton run on from the fit until it stalls, so
-    // that a term is never credited with what more iterations of the base would have done.
+    let judge0 = Judge { y: &data.output, held: &held, rows: &all_rows, noise_rms: 0.0, dt: data.dt };
+    progress.advance(1);
+    progress.message("round 1: naming");
+    let shared = contenders::Shared { data, train: &train, judge: &judge0, cands: &cands, rate: &dx, aux: &aux_refs };
+    let mut openings = contenders::open_all(&fitted, &shared)?;
+    let chosen = contenders::choose(&openings, &judge0);
+    let mut notes = fitted.failed.clone();
+    notes.extend(contenders::notes(&openings, chosen, &judge0, &cands, names));
+    let contenders::Opening { base, before, prob, mut current, located, first, .. } = openings.swap_remove(chosen);
+    let id = base.fit.model.clone();
+    let judge = Judge { noise_rms: located.noise_rms, ..judge0 };
+    let base_heldout = judge.heldout(&before);
+    // 3–4. Name and model, round by round.
     let diverges = || DiagnoseError::Diverges(id.clone());
-    let mut current = prob.refit(&[], &[], None, &base.fit.flat, BASE_ITERATIONS).map(|r| r.0).ok_or_else(diverges)?;
     let (mut findings, mut tested, mut used) = (Vec::new(), Vec::new(), Vec::<usize>::new());
     let y_span = span_on(&data.output, &held);
-    let mut notes = base.failed.clone();
-    if let Some((with_map, p)) = level_map::fit(&prob, &current, |pred| judge.heldout(pred).rmse) {
-        notes.push(level_map::note(&id, names, p));
-        current = with_map;
-    }
     // Joins of a dataset's runs, with any the caller gave: a finding sitting on one says so.
     let boundaries: Vec<usize> =
         opts.boundaries.iter().copied().chain(data.run_starts().into_iter().filter(|&s| s > 0)).collect();
+    let mut first = Some(first);
     for round in 0..opts.max_findings {
         progress.message(&format!("round {}: naming", round + 1));
-        let reference = rank::reference(&prob, &current).ok_or_else(diverges)?;
-        let Some(ranked) = rank::rank(&prob, &cands, &reference, &used) else {
-            notes.push(format!(
-                "round {}: the base model {id}'s Jacobian could not be taken at its fitted parameters (its \
-                 replay diverges when a parameter is nudged), so no further candidate was tested",
-                round + 1
-            ));
+        let opened = match first.take() {
+            Some(f) => f,
+            None => {
+                let reference = rank::reference(&prob, &current).ok_or_else(diverges)?;
+                rank::rank(&prob, &cands, &reference, &used).map(|ranked| {
+                    let verdict = judge.round(round + 1, &cands, &reference, ranked);
+                    (reference, verdict)
+                })
+            }
+        };
+        let Some((reference, verdict)) = opened else {
+            notes.push(jacobian_note(round + 1, &id));
             break;
         };
-        progress.advance(1);
-        progress.message(&format!("round {}: testing", round + 1));
-        let verdict = judge.round(round + 1, &cands, &reference, ranked);
+        progress.advance(2);
         tested.extend(verdict.tested);
-        progress.advance(1);
         let Some(kept) = verdict.accepted else { break };
         let c = &cands[kept.scored.index];
         let runner_up = describe::runner_up(&tested, round + 1, c.effect, &kept.test, kept.after.r_rmse);
@@ -197,7 +194,7 @@ fn diagnose_at_rate(
         findings,
         base_heldout,
         final_heldout: if unchanged { base_heldout } else { judge.heldout(&current.pred) },
-        bases_tried: base.tried,
+        bases_tried: fitted.tried,
         locate: located,
         channels,
         candidates: tested,
@@ -208,13 +205,21 @@ fn diagnose_at_rate(
             time: data.time.clone(),
             input: data.input.clone(),
             output: data.output.clone(),
-            before: base.fit.output.clone(),
+            before,
             after: current.pred,
             train_end: data.train_end,
             heldout_rows: held,
             fs: 1.0 / data.dt,
         },
     })
+}
+
+/// The note of a round (1-based) whose base `id` could not be differentiated.
+fn jacobian_note(round: usize, id: &str) -> String {
+    format!(
+        "round {round}: the base model {id}'s Jacobian could not be taken at its fitted parameters (its replay \
+         diverges when a parameter is nudged), so no further candidate was tested"
+    )
 }
 
 /// Peak-to-peak of `y` over `rows`.

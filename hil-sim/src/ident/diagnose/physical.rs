@@ -7,8 +7,10 @@ use super::augment::Fitted;
 use super::candidates::Candidate;
 
 /// Why the fitted candidate is impossible (in words, with the value and its unit), or
-/// `None` when it is possible. `n_old` is the number of terms the reference already had.
-pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64) -> Option<String> {
+/// `None` when it is possible. `n_old` is the number of terms the reference already had;
+/// `dt` the sample interval (s): a delay shorter than one sample is no finding, since a base
+/// model stepped once per sample lags its own state by up to that much.
+pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64) -> Option<String> {
     let coef = f.beta.get(n_old).copied().unwrap_or(0.0);
     if c.effect == "inertia" && coef < 0.0 {
         return Some(format!("a negative mass or inertia ({})", crate::numerics::number::num(coef, 4)));
@@ -25,6 +27,10 @@ pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64) -> Option
         "tau_s" | "lag_s" if value > 0.0 && at(hi) => {
             Some(format!("a time constant at the edge of its search range ({:.1} ms)", 1e3 * value))
         }
+        "delay_s" if value.abs() < dt => Some(format!(
+            "a delay shorter than one sample ({:+.2} ms): the base model's own discretisation shifts it by as much",
+            1e3 * value
+        )),
         "delay_s" if at(hi) || at(lo) => {
             Some(format!("a delay at the edge of its search range ({:+.2} ms)", 1e3 * value))
         }

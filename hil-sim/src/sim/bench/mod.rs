@@ -24,7 +24,7 @@
 //! and the torque.
 //!
 //! The seeds are split: [`Set::Development`] draws from one range, [`Set::Heldout`],
-//! [`Set::Fresh`] and [`Set::Fresh2`] from three others; the method is developed on the
+//! [`Set::Fresh`], [`Set::Fresh2`] and [`Set::Fresh3`] from four others; the method is developed on the
 //! first and reported on the others (each first run for one report).
 
 pub mod chain;
@@ -60,6 +60,8 @@ pub enum Set {
     Fresh,
     /// A third held-out range, first run for the report of 2026-11-25.
     Fresh2,
+    /// A fourth held-out range, first run for the report of 2026-11-26.
+    Fresh3,
 }
 
 impl Set {
@@ -70,6 +72,7 @@ impl Set {
             Set::Heldout => 7_300_000 + 7 * k,
             Set::Fresh => 9_100_000 + 11 * k,
             Set::Fresh2 => 12_700_000 + 13 * k,
+            Set::Fresh3 => 15_100_000 + 17 * k,
         }
     }
 }

@@ -16,15 +16,14 @@ fn every_effect_and_form_reaches_its_size_on_every_family() {
 
 #[test]
 fn the_sets_do_not_share_seeds_and_cover_everything() {
-    let dev: Vec<u64> = cases(Set::Development, 300, 60).iter().map(|c| c.seed).collect();
+    let sets = [Set::Development, Set::Heldout, Set::Fresh, Set::Fresh2, Set::Fresh3];
+    let seeds: Vec<Vec<u64>> = sets.iter().map(|s| cases(*s, 300, 60).iter().map(|c| c.seed).collect()).collect();
+    for (i, a) in seeds.iter().enumerate() {
+        for b in &seeds[i + 1..] {
+            assert!(a.iter().all(|s| !b.contains(s)), "two sets share a seed");
+        }
+    }
     let held = cases(Set::Heldout, 300, 60);
-    assert!(held.iter().all(|c| !dev.contains(&c.seed)));
-    let fresh = cases(Set::Fresh, 300, 60);
-    assert!(fresh.iter().all(|c| !dev.contains(&c.seed) && !held.iter().any(|h| h.seed == c.seed)));
-    let fresh2 = cases(Set::Fresh2, 300, 60);
-    assert!(fresh2.iter().all(|c| !dev.contains(&c.seed)
-        && !held.iter().any(|h| h.seed == c.seed)
-        && !fresh.iter().any(|f| f.seed == c.seed)));
     for (e, _) in EFFECTS {
         for x in EXCITATIONS {
             assert!(held.iter().any(|c| c.effect == *e && c.excitation == *x), "{e} {x}");
