@@ -38,6 +38,9 @@ pub enum Transform {
     Lag2 { tau_s: f64 },
     /// `b_s · tanh(x / b_s)`.
     Saturate { b_sat: f64 },
+    /// A sharper knee, `x / (1 + (x / b_s)⁴)^¼`: linear up to near `b_s`, then flat (steel
+    /// saturating in a narrow range of the field).
+    SaturateKnee { b_sat: f64 },
     /// The recorded input reads `b_0` high: the model sees `x − b_0`.
     Offset { b_0: f64 },
 }
@@ -62,6 +65,7 @@ impl Transform {
                 half.apply(&half.apply(x, dt), dt)
             }
             Self::Saturate { b_sat } => x.iter().map(|v| b_sat * (v / b_sat).tanh()).collect(),
+            Self::SaturateKnee { b_sat } => x.iter().map(|v| v / (1.0 + (v / b_sat).powi(4)).powf(0.25)).collect(),
             Self::Offset { b_0 } => x.iter().map(|v| v - b_0).collect(),
         }
     }

@@ -325,6 +325,14 @@ fn input_transforms(s: &InputStats) -> Vec<Candidate> {
             channel: None,
         },
         Candidate {
+            effect: "saturation",
+            label: "saturating map of the input with a sharp knee".into(),
+            grid_name: Some("b_sat".into()),
+            grid: log_grid(0.6 * s.x_max, 6.0 * s.x_max, 10),
+            build: Box::new(|b| Piece { transform: Some(Transform::SaturateKnee { b_sat: b }), terms: vec![] }),
+            channel: None,
+        },
+        Candidate {
             effect: "sensor_offset",
             label: "zero offset of the input".into(),
             grid_name: Some("b_0".into()),

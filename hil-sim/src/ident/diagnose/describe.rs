@@ -179,6 +179,10 @@ fn what(d: &Described<'_>) -> String {
             -1e3 * g,
             -g / dt
         ),
+        "saturation" if c.label.contains("knee") => format!(
+            "the {i} saturates with a sharp knee: the {o} follows b/(1 + (b/b_s)⁴)^¼ with b_s = {} (steel saturating over a narrow range of the field)",
+            with_unit(g, &xu)
+        ),
         "saturation" => format!(
             "the {i} saturates: the {o} follows b_s·tanh(b/b_s) with b_s = {} (yield stress or steel saturating at high field)",
             with_unit(g, &xu)

@@ -5,7 +5,9 @@
 //! 1. **Base** ([`base`]). The base model is fitted on the training part (the first
 //!    `1 − heldout_fraction`) with the channels as recorded (no delay fitted: a time shift
 //!    between channels is a finding, not something to absorb silently). `auto` fits every
-//!    seed model ([`AUTO_BASES`]) and keeps the best held-out one. A static power-law term of
+//!    seed model ([`AUTO_BASES`]); the structurally different ones close to the best, and the
+//!    algebraic model with play operators, each get the first round, and the base whose first
+//!    round predicts the held-out part best is kept ([`contenders`]). A static power-law term of
 //!    the input ([`level_map`]: the torque growing faster than linearly with the field) joins
 //!    the base when it helps, with a note: a curvature the base family lacks is not physics
 //!    left out.
