@@ -7,8 +7,8 @@
 //!
 //! - [`blind_subset_of_heldout_seeds`]: a fixed subset of held-out cases (the first 18
 //!   effect and 4 null cases at 500 Hz–2 kHz of the held-out set), asserting a floor set
-//!   from the development runs (at least 40 % named first, at most one false alarm): the
-//!   method does not reach the 95 % (docs/diagnose.md has the held-out table).
+//!   from the development runs (at least 65 % named first, at most one false alarm): a
+//!   regression guard; docs/diagnose.md has the held-out table.
 //! - [`bench_table`] (ignored, about 25 minutes): the full table, per effect and per
 //!   excitation: `BENCH_SET=heldout cargo test --release -p integration-tests --test
 //!   diagnose_concealed -- --ignored --nocapture` (`BENCH_SET=dev` for the development
@@ -204,11 +204,12 @@ fn blind_subset_of_heldout_seeds() {
     let outcomes = run_all(&subset(18, 4));
     let t = table(&outcomes);
     println!("{t}");
-    // A floor set from the development runs before the held-out set was run (57 % of the
-    // effect cases, 8 of 10 nulls clean there): a regression guard, not the 95 %.
+    // A floor set from the development runs before this subset was run with the method of
+    // 2026-11-26 (72 of 80 effect cases named first, 16 of 16 nulls clean there; 57 % and
+    // 8 of 10 when the floor was 40 %): a regression guard, not the 95 %.
     let (all, _, alarms) = rates(&outcomes);
     assert!(alarms <= 1, "{alarms} false alarms in 4 nulls\n{t}");
-    assert!(all >= 0.4, "{:.1} % named first\n{t}", 100.0 * all);
+    assert!(all >= 0.65, "{:.1} % named first\n{t}", 100.0 * all);
 }
 
 #[test]
