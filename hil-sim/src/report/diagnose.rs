@@ -145,7 +145,10 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
             ]
         })
         .collect();
-    rep.paragraph("Every candidate tested, by round (kept: first by BIC gain that passes the held-out block test):");
+    rep.paragraph(
+        "Every candidate tested, by round, by BIC gain (kept: of those that pass the held-out block test, the one with \
+         the lowest held-out error):",
+    );
     rep.table(&["round", "effect", "term", "BIC gain", "held-out R-RMSE (%)", "t-statistic", ""], &tested);
 }
 
