@@ -275,7 +275,7 @@ fn note(openings: &[Opening<'_>], chosen: usize, judge: &Judge<'_>, cands: &[Can
 mod tests {
     use super::*;
     use crate::ident::diagnose::{diagnose, DiagnoseOptions};
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
 
     #[test]
     fn a_play_follows_its_input_within_its_radius_and_holds_on_a_reversal() {
@@ -303,22 +303,7 @@ mod tests {
             .map(|(r, w)| play(&seen, *r).iter().map(|p| w * p).collect())
             .collect();
         let y: Vec<f64> = (0..n).map(|i| 0.5 + 12.0 * seen[i] + hyst.iter().map(|h| h[i]).sum::<f64>()).collect();
-        let (lo, hi) = y.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
-        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-        let noise = 0.005 * (hi - lo) * 12f64.sqrt();
-        let output = y.iter().map(|v| v + noise * (rng.random::<f64>() - 0.5)).collect();
-        crate::ident::fit::Dataset {
-            dt,
-            time,
-            input: x,
-            output,
-            command: None,
-            train_end: 8400,
-            excluded: vec![false; n],
-            unusable: Vec::new(),
-            rates: None,
-            runs: Vec::new(),
-        }
+        crate::ident::diagnose::tests::with_noise(x, &y, &mut rand::rngs::StdRng::seed_from_u64(seed))
     }
 
     fn effects(d: &crate::ident::fit::Dataset) -> (Vec<String>, Vec<String>) {

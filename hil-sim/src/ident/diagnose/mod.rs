@@ -268,16 +268,23 @@ mod tests {
         let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
         let out = crate::models::replay("bouc_wen", &truth, dt as f32, RateSpec::Backward, &samples).unwrap();
         let y: Vec<f64> = out.y.iter().zip(&x).map(|(v, x)| f64::from(*v) + extra(*x)).collect();
+        with_noise(x, &y, &mut rng)
+    }
+
+    /// A 1 kHz dataset of the input `x` and the output `y` with uniform white noise of 0.5 %
+    /// of its span (RMS) drawn from `rng`; the first 70 % trains.
+    pub(super) fn with_noise(x: Vec<f64>, y: &[f64], rng: &mut impl Rng) -> Dataset {
+        let (dt, n) = (1e-3, x.len());
         let (lo, hi) = y.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
         let noise = 0.005 * (hi - lo);
         let output = y.iter().map(|v| v + noise * (rng.random::<f64>() - 0.5) * 12f64.sqrt()).collect();
         Dataset {
             dt,
-            time,
+            time: (0..n).map(|i| i as f64 * dt).collect(),
             input: x,
             output,
             command: None,
-            train_end: 8400,
+            train_end: n * 7 / 10,
             excluded: vec![false; n],
             unusable: Vec::new(),
             rates: None,
