@@ -28,6 +28,39 @@ pub const AUTO_BASES: &[&str] = &[
     models::trig::Registered::ID,
 ];
 
+/// Seed models of one structure: a group's best member stands for it.
+pub const GROUPS: &[&[&str]] = &[
+    &["tanh"],
+    &["dahl", "lugre"],
+    &["bouc_wen", "spencer"],
+    &["algebraic"],
+    &["bingham", "arctan", "arctan_inertia", "trig"],
+];
+/// Most contenders, the best-fitting base included.
+pub const MAX: usize = 4;
+/// A contender's held-out RMSE is at most this multiple of the best one's.
+pub const WITHIN: f64 = 2.5;
+/// The seed model that is also a contender with play operators ([`plays`]): the stateless
+/// algebraic model, so that the loop is the operators' alone.
+pub const PLAY_HOST: &str = <model_core::models::algebraic::Registered as model_core::Model>::ID;
+/// The contenders among `scored` (model id and held-out RMSE, best first): indices into it,
+/// the best first.
+pub fn pick(scored: &[(&str, f64)]) -> Vec<usize> {
+    let Some(&(first, best)) = scored.first() else { return Vec::new() };
+    let group = |id: &str| GROUPS.iter().position(|g| g.contains(&id));
+    let mut seen = vec![group(first)];
+    let mut keep = vec![0];
+    for (k, &(id, s)) in scored.iter().enumerate().skip(1) {
+        let g = group(id);
+        if keep.len() >= MAX || s > WITHIN * best || g.is_none() || seen.contains(&g) {
+            continue;
+        }
+        seen.push(g);
+        keep.push(k);
+    }
+    keep
+}
+
 /// Levenberg–Marquardt iterations of the base model's fit.
 const LM_ITERATIONS: usize = 30;
 /// Rows this close to either end (s, plus two samples) are left out of the refits and the
@@ -43,10 +76,10 @@ pub struct Base {
 
 /// Every base model fitted, the contenders among them and what failed.
 pub struct Bases {
-    /// The contenders ([`super::contenders::pick`]), the best held-out one first.
+    /// The contenders ([`pick`]), the best held-out one first.
     pub contenders: Vec<Base>,
     /// With `auto`: the seed model that is also tried with play operators
-    /// ([`super::contenders::PLAY_HOST`]), when it could be fitted.
+    /// ([`PLAY_HOST`]), when it could be fitted.
     pub play_host: Option<Base>,
     /// Every base model fitted, with its held-out R-RMSE.
     pub tried: Vec<(String, f64)>,
@@ -63,7 +96,7 @@ pub fn choices(opts: &DiagnoseOptions) -> Vec<&str> {
 }
 
 /// Fit every base of `bases` (one progress step each); the best held-out one and the other
-/// contenders ([`super::contenders::pick`]) are made ready for the refits.
+/// contenders ([`pick`]) are made ready for the refits.
 pub fn fit_bases(
     data: &Dataset,
     bases: &[&str],
@@ -100,8 +133,8 @@ pub fn fit_bases(
         return Err(DiagnoseError::NoBase(errors.join("; ")));
     }
     let scored: Vec<(&str, f64)> = fits.iter().map(|r| (r.model.as_str(), score(r))).collect();
-    let keep = super::contenders::pick(&scored);
-    let host = fits.iter().find(|r| opts.model.is_none() && r.model == super::contenders::PLAY_HOST).cloned();
+    let keep = pick(&scored);
+    let host = fits.iter().find(|r| opts.model.is_none() && r.model == PLAY_HOST).cloned();
     let play_host = host.and_then(|f| ready(data, f).ok());
     let mut contenders = Vec::with_capacity(keep.len());
     for (k, fit) in fits.into_iter().enumerate().filter(|(k, _)| keep.contains(k)) {
@@ -137,4 +170,29 @@ pub fn rows(data: &Dataset) -> (Vec<usize>, Vec<usize>) {
     let train = data.train_rows().into_iter().filter(inside).collect();
     let held = data.heldout_unflagged().into_iter().filter(inside).collect();
     (train, held)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_contender_per_structure_close_to_the_best() {
+        let scored = [
+            ("dahl", 1.0),
+            ("lugre", 1.01),
+            ("bouc_wen", 1.2),
+            ("spencer", 1.3),
+            ("bingham", 1.9),
+            ("tanh", 2.0),
+            ("algebraic", 2.4),
+            ("trig", 2.6),
+        ];
+        // lugre shares dahl's structure, spencer bouc_wen's; at most four.
+        assert_eq!(pick(&scored), vec![0, 2, 4, 5]);
+        assert_eq!(pick(&scored[..1]), vec![0]);
+        assert!(pick(&[]).is_empty());
+        // trig is beyond 2.5× the best.
+        assert_eq!(pick(&[("dahl", 1.0), ("trig", 2.6), ("tanh", 1.2)]), vec![0, 2]);
+    }
 }

@@ -2,8 +2,9 @@
 //! family can absorb part of a concealed effect (Dahl's internal state takes up a field lag
 //! on a tanh-type clutch) and fit the recording best while hiding the effect, whose
 //! remainder is then named as something else. Each structurally different family close to
-//! the best ([`pick`]: one per group of [`GROUPS`], within [`WITHIN`] of the best held-out
-//! error, at most [`MAX`]) gets the first round on its own ([`open`]), and [`choose`] keeps
+//! the best ([`super::base::pick`]: one per group of [`super::base::GROUPS`], within
+//! [`super::base::WITHIN`] of the best held-out error, at most [`super::base::MAX`]) gets the
+//! first round on its own ([`open`]), and [`choose`] keeps
 //! the base whose first round predicts the held-out part best: a base with a finding is
 //! chosen only when that prediction beats the best base without one by the paired block
 //! test ([`super::significance`]); otherwise the best base without a finding is kept.
@@ -16,50 +17,17 @@ use rayon::prelude::*;
 
 use super::accept::{Judge, Verdict};
 use super::augment::{Fitted, Problem, Term};
-use super::base::{Base, Bases};
+use super::base::{Base, Bases, PLAY_HOST};
 use super::candidates::Candidate;
 use super::locate::{self, Locate};
 use super::options::DiagnoseError;
 use super::{level_map, rank, significance};
 use crate::ident::fit::Dataset;
 
-/// Seed models of one structure: a group's best member stands for it.
-pub const GROUPS: &[&[&str]] = &[
-    &["tanh"],
-    &["dahl", "lugre"],
-    &["bouc_wen", "spencer"],
-    &["algebraic"],
-    &["bingham", "arctan", "arctan_inertia", "trig"],
-];
-/// Most contenders, the best-fitting base included.
-pub const MAX: usize = 4;
-/// A contender's held-out RMSE is at most this multiple of the best one's.
-pub const WITHIN: f64 = 2.5;
-/// The seed model that is also a contender with play operators ([`plays`]): the stateless
-/// algebraic model, so that the loop is the operators' alone.
-pub const PLAY_HOST: &str = <model_core::models::algebraic::Registered as model_core::Model>::ID;
 /// Radii of the play operators, fractions of the input's span.
 pub const PLAY_RADII: &[f64] = &[0.01, 0.03, 0.07, 0.15];
 /// Gauss–Newton iterations that converge a fitted base before its first round.
 const BASE_ITERATIONS: usize = 8;
-
-/// The contenders among `scored` (model id and held-out RMSE, best first): indices into it,
-/// the best first.
-pub fn pick(scored: &[(&str, f64)]) -> Vec<usize> {
-    let Some(&(first, best)) = scored.first() else { return Vec::new() };
-    let group = |id: &str| GROUPS.iter().position(|g| g.contains(&id));
-    let mut seen = vec![group(first)];
-    let mut keep = vec![0];
-    for (k, &(id, s)) in scored.iter().enumerate().skip(1) {
-        let g = group(id);
-        if keep.len() >= MAX || s > WITHIN * best || g.is_none() || seen.contains(&g) {
-            continue;
-        }
-        seen.push(g);
-        keep.push(k);
-    }
-    keep
-}
 
 /// A play operator (backlash) of radius `r`: its output follows `x` within `±r`, starting
 /// at `x[0]`.
@@ -323,25 +291,5 @@ mod tests {
     fn on_that_loop_a_field_lag_is_still_named() {
         let (found, notes) = effects(&play_clutch(0.006, 6));
         assert_eq!(found.first().map(String::as_str), Some("field_lag"), "{found:?} {notes:?}");
-    }
-
-    #[test]
-    fn one_contender_per_structure_close_to_the_best() {
-        let scored = [
-            ("dahl", 1.0),
-            ("lugre", 1.01),
-            ("bouc_wen", 1.2),
-            ("spencer", 1.3),
-            ("bingham", 1.9),
-            ("tanh", 2.0),
-            ("algebraic", 2.4),
-            ("trig", 2.6),
-        ];
-        // lugre shares dahl's structure, spencer bouc_wen's; at most four.
-        assert_eq!(pick(&scored), vec![0, 2, 4, 5]);
-        assert_eq!(pick(&scored[..1]), vec![0]);
-        assert!(pick(&[]).is_empty());
-        // trig is beyond 2.5× the best.
-        assert_eq!(pick(&[("dahl", 1.0), ("trig", 2.6), ("tanh", 1.2)]), vec![0, 2]);
     }
 }
