@@ -40,7 +40,7 @@ pub const GROUPS: &[&[&str]] = &[
 pub const MAX: usize = 4;
 /// A contender's held-out RMSE is at most this multiple of the best one's.
 pub const WITHIN: f64 = 2.5;
-/// The seed model that is also a contender with play operators ([`plays`]): the stateless
+/// The seed model that is also a contender with play operators (`contenders.rs`): the stateless
 /// algebraic model, so that the loop is the operators' alone.
 pub const PLAY_HOST: &str = <model_core::models::algebraic::Registered as model_core::Model>::ID;
 /// The contenders among `scored` (model id and held-out RMSE, best first): indices into it,
