@@ -288,59 +288,54 @@ fn input_transforms(s: &InputStats) -> Vec<Candidate> {
     let reach = (0.03 * fs).round().max(4.0);
     let stride = (reach / 40.0).ceil();
     let max_delay = (reach / stride).round();
+    let delays: Vec<f64> =
+        (-(max_delay as i64)..=max_delay as i64).filter(|k| *k != 0).map(|k| k as f64 * stride * dt).collect();
+    let levels = log_grid(0.6 * s.x_max, 6.0 * s.x_max, 10);
+    let offsets: Vec<f64> = (-8..=8).filter(|k| *k != 0).map(|k| f64::from(k) * 0.01 * s.x_span).collect();
     vec![
-        Candidate {
-            effect: "field_lag",
-            label: "first-order lag of the input".into(),
-            grid_name: Some("tau_s".into()),
-            grid: log_grid(dt, (0.05f64).max(4.0 * dt), 14),
-            build: Box::new(|tau| Piece { transform: Some(Transform::Lag { tau_s: tau }), terms: vec![] }),
-            channel: None,
-        },
-        Candidate {
-            effect: "field_lag",
-            label: "two-pole lag of the input".into(),
-            grid_name: Some("tau_s".into()),
-            grid: log_grid(2.0 * dt, (0.05f64).max(8.0 * dt), 14),
-            build: Box::new(|tau| Piece { transform: Some(Transform::Lag2 { tau_s: tau }), terms: vec![] }),
-            channel: None,
-        },
-        Candidate {
-            effect: "transport_delay",
-            label: "time shift between input and output".into(),
-            grid_name: Some("delay_s".into()),
-            grid: (-(max_delay as i64)..=max_delay as i64)
-                .filter(|k| *k != 0)
-                .map(|k| k as f64 * stride * dt)
-                .collect(),
-            build: Box::new(|d| Piece { transform: Some(Transform::Delay { delay_s: d }), terms: vec![] }),
-            channel: None,
-        },
-        Candidate {
-            effect: "saturation",
-            label: "saturating map of the input".into(),
-            grid_name: Some("b_sat".into()),
-            grid: log_grid(0.6 * s.x_max, 6.0 * s.x_max, 10),
-            build: Box::new(|b| Piece { transform: Some(Transform::Saturate { b_sat: b }), terms: vec![] }),
-            channel: None,
-        },
-        Candidate {
-            effect: "saturation",
-            label: "saturating map of the input with a sharp knee".into(),
-            grid_name: Some("b_sat".into()),
-            grid: log_grid(0.6 * s.x_max, 6.0 * s.x_max, 10),
-            build: Box::new(|b| Piece { transform: Some(Transform::SaturateKnee { b_sat: b }), terms: vec![] }),
-            channel: None,
-        },
-        Candidate {
-            effect: "sensor_offset",
-            label: "zero offset of the input".into(),
-            grid_name: Some("b_0".into()),
-            grid: (-8..=8).filter(|k| *k != 0).map(|k| f64::from(k) * 0.01 * s.x_span).collect(),
-            build: Box::new(|b| Piece { transform: Some(Transform::Offset { b_0: b }), terms: vec![] }),
-            channel: None,
-        },
+        transform(
+            "field_lag",
+            "first-order lag of the input",
+            "tau_s",
+            log_grid(dt, (0.05f64).max(4.0 * dt), 14),
+            |tau| Transform::Lag { tau_s: tau },
+        ),
+        transform(
+            "field_lag",
+            "two-pole lag of the input",
+            "tau_s",
+            log_grid(2.0 * dt, (0.05f64).max(8.0 * dt), 14),
+            |tau| Transform::Lag2 { tau_s: tau },
+        ),
+        transform("transport_delay", "time shift between input and output", "delay_s", delays, |d| Transform::Delay {
+            delay_s: d,
+        }),
+        transform("saturation", "saturating map of the input", "b_sat", levels.clone(), |b| Transform::Saturate {
+            b_sat: b,
+        }),
+        transform("saturation", "saturating map of the input with a sharp knee", "b_sat", levels, |b| {
+            Transform::SaturateKnee { b_sat: b }
+        }),
+        transform("sensor_offset", "zero offset of the input", "b_0", offsets, |b| Transform::Offset { b_0: b }),
     ]
+}
+
+/// A candidate that feeds the base model the input through `make(g)`, `g` on `grid`.
+fn transform(
+    effect: &'static str,
+    label: &str,
+    grid_name: &str,
+    grid: Vec<f64>,
+    make: fn(f64) -> Transform,
+) -> Candidate {
+    Candidate {
+        effect,
+        label: label.into(),
+        grid_name: Some(grid_name.into()),
+        grid,
+        build: Box::new(move |g| Piece { transform: Some(make(g)), terms: vec![] }),
+        channel: None,
+    }
 }
 
 /// Rate dependence in three shapes (`c·|ẋ|ẋ`, `c·ẋ³`, and a damping that grows with the
