@@ -1,6 +1,7 @@
 //! Stage 4 of a diagnosis, modelling: in the round's ranking, the first candidate that
 //! lowers the training error, gains on the information criterion, passes the held-out
-//! block test ([`super::significance`]), changes the prediction by more than the
+//! block test ([`super::significance`]) with a gain of at least
+//! [`significance::MIN_FINDING_GAIN`], changes the prediction by more than the
 //! residual's noise floor resolves and is physically possible ([`super::physical`]) is
 //! kept; every candidate is recorded as tested.
 
@@ -68,6 +69,7 @@ impl Judge<'_> {
                 && s.bic_gain > 0.0
                 && f.train_mse < reference.train_mse
                 && test.significant
+                && test.gain >= significance::MIN_FINDING_GAIN
                 && resolvable;
             tested.push(Tested {
                 round,

@@ -76,24 +76,48 @@ impl Transform {
 pub struct Term {
     /// Name of the coefficient in the finding's `params`.
     pub name: String,
-    /// `v_k` (one value per sample).
+    /// `v_k` (one value per sample; empty for [`TermKind::OutputSaturation`]).
     pub values: Vec<f64>,
-    /// When true the term is `m_θ · v_k` (a parameter of the base model scaled by `v_k`).
-    pub times_model: bool,
+    pub kind: TermKind,
+}
+
+/// How a term's column is made from its values and the base model's output `m`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TermKind {
+    /// `v_k`.
+    Additive,
+    /// `m_θ · v_k` (a parameter of the base model scaled by `v_k`).
+    TimesModel,
+    /// The model's output above its floor compressed, less itself: with `u = m − min m`,
+    /// `min m + u/√(1 + (u/t_sat)²) − m` (the fluid's yield stress saturating, so the
+    /// torque flattens at high field whatever the field does; β ≈ 1 for exactly that map).
+    OutputSaturation { t_sat: f64 },
 }
 
 impl Term {
     pub fn additive(name: impl Into<String>, values: Vec<f64>) -> Self {
-        Self { name: name.into(), values, times_model: false }
+        Self { name: name.into(), values, kind: TermKind::Additive }
     }
     pub fn scaling(name: impl Into<String>, values: Vec<f64>) -> Self {
-        Self { name: name.into(), values, times_model: true }
+        Self { name: name.into(), values, kind: TermKind::TimesModel }
+    }
+    pub fn output_saturation(name: impl Into<String>, t_sat: f64) -> Self {
+        Self { name: name.into(), values: Vec::new(), kind: TermKind::OutputSaturation { t_sat } }
     }
     fn column(&self, m: &[f64]) -> Vec<f64> {
-        if self.times_model {
-            self.values.iter().zip(m).map(|(v, m)| v * m).collect()
-        } else {
-            self.values.clone()
+        match self.kind {
+            TermKind::Additive => self.values.clone(),
+            TermKind::TimesModel => self.values.iter().zip(m).map(|(v, m)| v * m).collect(),
+            TermKind::OutputSaturation { t_sat } => {
+                let floor = m.iter().copied().fold(f64::INFINITY, f64::min);
+                let s = t_sat.max(1e-300);
+                m.iter()
+                    .map(|m| {
+                        let u = m - floor;
+                        u / (1.0 + (u / s).powi(2)).sqrt() - u
+                    })
+                    .collect()
+            }
         }
     }
 }

@@ -264,6 +264,7 @@ fn additive(
 pub fn all(data: &Dataset, aux: &[AuxChannel], input_is_field: bool) -> Vec<Candidate> {
     let s = InputStats::of(data);
     let mut out = input_transforms(&s);
+    out.push(yield_saturation(data));
     out.extend(
         kinematic_terms(&s, aux)
             .into_iter()
@@ -318,6 +319,23 @@ fn input_transforms(s: &InputStats) -> Vec<Candidate> {
         }),
         transform("sensor_offset", "zero offset of the input", "b_0", offsets, |b| Transform::Offset { b_0: b }),
     ]
+}
+
+/// Saturation on the output side: the fluid's yield stress levelling off at high field, so
+/// the torque above its floor is compressed, `T_lo + u/√(1 + (u/T_s)²)` of the model's
+/// `u = T − T_lo`, whatever the field did (the steel saturating is the input's map above).
+/// `T_s` from 0.3 to 10 output spans; the term's coefficient is ≈ 1 for exactly that map.
+fn yield_saturation(data: &Dataset) -> Candidate {
+    let (lo, hi) = data.output.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+    let span = (hi - lo).max(1e-300);
+    Candidate {
+        effect: "saturation",
+        label: "saturating torque at high level (yield stress)".into(),
+        grid_name: Some("t_sat".into()),
+        grid: log_grid(0.3 * span, 10.0 * span, 12),
+        build: Box::new(|t| Piece { transform: None, terms: vec![Term::output_saturation("k_sat", t)] }),
+        channel: None,
+    }
 }
 
 /// A candidate that feeds the base model the input through `make(g)`, `g` on `grid`.

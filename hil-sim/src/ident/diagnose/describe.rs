@@ -101,6 +101,8 @@ pub fn finding(d: &Described<'_>) -> Finding {
         params.insert(name.clone(), g);
         if name == "b_sat" || name == "b_0" {
             units.insert(name.clone(), xu.to_owned());
+        } else if name == "t_sat" {
+            units.insert(name.clone(), yu.to_owned());
         } else if name.ends_with("_s") {
             units.insert(name.clone(), "s".to_owned());
         }
@@ -178,6 +180,11 @@ fn what(d: &Described<'_>) -> String {
             "the {i} channel is recorded {:.2} ms late relative to the {o} ({:.1} samples): a timing skew between the channels (ADC pipeline, logger, a filter on one channel)",
             -1e3 * g,
             -g / dt
+        ),
+        "saturation" if c.grid_name.as_deref() == Some("t_sat") => format!(
+            "the {o} levels off at high level whatever the {i} does (the fluid's yield stress saturating): above its floor it follows u/√(1 + (u/T_s)²) of the model's, T_s = {} ({} of that map)",
+            with_unit(g, &yu),
+            with_unit(100.0 * coef, "%")
         ),
         "saturation" if c.label.contains("knee") => format!(
             "the {i} saturates with a sharp knee: the {o} follows b/(1 + (b/b_s)⁴)^¼ with b_s = {} (steel saturating over a narrow range of the field)",

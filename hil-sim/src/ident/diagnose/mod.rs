@@ -308,6 +308,34 @@ mod tests {
     }
 
     #[test]
+    fn a_yield_stress_levelling_off_is_named_on_the_output_side() {
+        // A unipolar field 0.2–1.8; the torque above its floor compressed by
+        // u/√(1 + (u/T_s)²) with T_s = 1.5 spans (the RMS change is some 6 % of the span).
+        let dt = 1e-3;
+        let tone = |t: f64, f: f64, ph: f64| (2.0 * std::f64::consts::PI * f * t + ph).sin();
+        let x: Vec<f64> = (0..12_000)
+            .map(|i| i as f64 * dt)
+            .map(|t| 1.0 + 0.5 * tone(t, 2.0, 0.0) + 0.2 * tone(t, 7.3, 1.0) + 0.1 * tone(t, 13.1, 2.0))
+            .collect();
+        let rates = crate::numerics::derivative::rates(&x, dt);
+        let samples = crate::models::replay::samples_with_rates(&x, None, Some(&rates));
+        let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
+        let out = crate::models::replay("bouc_wen", &truth, dt as f32, RateSpec::Backward, &samples).unwrap();
+        let m: Vec<f64> = out.y.iter().map(|v| f64::from(*v)).collect();
+        let (lo, hi) = m.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+        let s = 1.5 * (hi - lo);
+        let y: Vec<f64> = m.iter().map(|v| lo + (v - lo) / (1.0 + ((v - lo) / s).powi(2)).sqrt()).collect();
+        let change = (m.iter().zip(&y).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / m.len() as f64).sqrt();
+        assert!(change > 0.03 * (hi - lo), "the effect is {:.1} % of the span", 100.0 * change / (hi - lo));
+        let d = run(&with_noise(x, &y, &mut rand::rngs::StdRng::seed_from_u64(7)));
+        let top = d.findings.first().expect("a finding");
+        assert_eq!(top.effect, "saturation", "{:#?}", d.candidates);
+        let t_sat = top.params.get("t_sat").copied().expect("the output-side saturation");
+        assert!(t_sat > 0.5 * (hi - lo) && t_sat < 5.0 * (hi - lo), "T_s {t_sat} for a span of {}", hi - lo);
+        assert_eq!(top.units.get("t_sat").map(String::as_str), Some("N·m"), "{:?}", top.units);
+    }
+
+    #[test]
     fn nothing_missing_gives_no_finding() {
         let d = run(&recording(None, 2));
         assert!(d.findings.is_empty(), "{:#?}", d.findings);

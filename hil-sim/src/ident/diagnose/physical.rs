@@ -1,5 +1,6 @@
 //! Whether a candidate's fitted values are physically possible: a finding is never a
-//! negative mass or inertia, a time constant or saturation level that is not positive,
+//! negative mass or inertia, a time constant or saturation level that is not positive, a
+//! yield-stress saturation that expands the torque instead,
 //! or a lag, delay or channel lag pinned at the edge of its search range (the refit
 //! wanted more than the range allows: the term is standing in for something else).
 
@@ -14,6 +15,12 @@ pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64) 
     let coef = f.beta.get(n_old).copied().unwrap_or(0.0);
     if c.effect == "inertia" && coef < 0.0 {
         return Some(format!("a negative mass or inertia ({})", crate::numerics::number::num(coef, 4)));
+    }
+    if c.grid_name.as_deref() == Some("t_sat") && coef <= 0.0 {
+        return Some(format!(
+            "a torque growing faster, not levelling off, at high level (k = {})",
+            crate::numerics::number::num(coef, 4)
+        ));
     }
     let name = c.grid_name.as_deref()?;
     if c.grid.len() < 2 {
