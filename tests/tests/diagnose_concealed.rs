@@ -12,9 +12,10 @@
 //! - [`bench_table`] (ignored, about 25 minutes): the full table, per effect and per
 //!   excitation: `BENCH_SET=heldout cargo test --release -p integration-tests --test
 //!   diagnose_concealed -- --ignored --nocapture` (`BENCH_SET=dev` for the development
-//!   seeds, `fresh`, `fresh2` and `fresh3` for the second, third and fourth held-out ranges; `BENCH_N`, `BENCH_NULL` for the number of
-//!   effect and null cases, default 256 and 48; `BENCH_MIN_FS`, `BENCH_MAX_FS` keep only the
-//!   cases sampled within those rates, Hz). It prints one line per case and writes
+//!   seeds, `fresh` … `fresh4` for the second to fifth held-out ranges; `BENCH_N`,
+//!   `BENCH_NULL` for the number of effect and null cases, default 256 and 48;
+//!   `BENCH_MIN_FS`, `BENCH_MAX_FS` keep only the cases sampled within those rates, Hz;
+//!   `BENCH_SEEDS=a,b,…` only the cases with those seeds). It prints one line per case and writes
 //!   `target/bench_<set>.md`; `BENCH_DUMP=FILE` appends a JSON line per case (the case,
 //!   the findings, every candidate tested with its statistics) for studying a decision rule
 //!   offline.
@@ -213,7 +214,7 @@ fn blind_subset_of_heldout_seeds() {
 }
 
 #[test]
-#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2|fresh3|dev, BENCH_N, BENCH_NULL"]
+#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2|fresh3|fresh4|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
     let sets = [
         ("dev", Set::Development),
@@ -221,6 +222,7 @@ fn bench_table() {
         ("fresh", Set::Fresh),
         ("fresh2", Set::Fresh2),
         ("fresh3", Set::Fresh3),
+        ("fresh4", Set::Fresh4),
     ];
     let key = std::env::var("BENCH_SET").ok();
     let (key, set) = sets.into_iter().find(|(k, _)| key.as_deref() == Some(*k)).unwrap_or(sets[1]);
@@ -230,7 +232,15 @@ fn bench_table() {
     let env = |k: &str, d: usize| std::env::var(k).ok().and_then(|v| v.parse().ok()).unwrap_or(d);
     // BENCH_MIN_FS / BENCH_MAX_FS: only the cases sampled within these rates, Hz.
     let fs = (env("BENCH_MIN_FS", 0) as f64, env("BENCH_MAX_FS", usize::MAX) as f64);
-    let all: Vec<Case> = cases(set, n, n_null).into_iter().filter(|c| c.fs_hz >= fs.0 && c.fs_hz <= fs.1).collect();
+    // BENCH_SEEDS: only the cases with these seeds (comma-separated), to rerun a few.
+    let only: Vec<u64> = std::env::var("BENCH_SEEDS")
+        .map(|v| v.split(',').filter_map(|s| s.trim().parse().ok()).collect())
+        .unwrap_or_default();
+    let all: Vec<Case> = cases(set, n, n_null)
+        .into_iter()
+        .filter(|c| c.fs_hz >= fs.0 && c.fs_hz <= fs.1)
+        .filter(|c| only.is_empty() || only.contains(&c.seed))
+        .collect();
     let (from, to) = (env("BENCH_FROM", 0).min(all.len()), env("BENCH_TO", all.len()).min(all.len()));
     let outcomes = run_all(&all[from..to.max(from)]);
     let t = table(&outcomes);

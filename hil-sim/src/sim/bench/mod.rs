@@ -24,7 +24,7 @@
 //! and the torque.
 //!
 //! The seeds are split: [`Set::Development`] draws from one range, [`Set::Heldout`],
-//! [`Set::Fresh`], [`Set::Fresh2`] and [`Set::Fresh3`] from four others; the method is developed on the
+//! [`Set::Fresh`], [`Set::Fresh2`], [`Set::Fresh3`] and [`Set::Fresh4`] from five others; the method is developed on the
 //! first and reported on the others (each first run for one report).
 
 pub mod chain;
@@ -62,6 +62,8 @@ pub enum Set {
     Fresh2,
     /// A fourth held-out range, first run for the report of 2026-11-26.
     Fresh3,
+    /// A fifth held-out range, first run for the report of 2026-11-27.
+    Fresh4,
 }
 
 impl Set {
@@ -73,6 +75,7 @@ impl Set {
             Set::Fresh => 9_100_000 + 11 * k,
             Set::Fresh2 => 12_700_000 + 13 * k,
             Set::Fresh3 => 15_100_000 + 17 * k,
+            Set::Fresh4 => 18_300_000 + 19 * k,
         }
     }
 }
