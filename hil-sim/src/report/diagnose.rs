@@ -135,7 +135,7 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
                 format!("{}", c.round),
                 format!("`{}`", c.effect),
                 match &c.value {
-                    Some((n, v)) => format!("{} ({n} = {})", c.label, with_unit(*v, 4, suffix_unit(n))),
+                    Some((n, v)) => format!("{} ({n} = {})", c.label, with_unit(*v, 4, grid_unit(d, n))),
                     None => c.label.clone(),
                 },
                 format!("{:.1}", c.bic_gain),
@@ -157,6 +157,16 @@ fn value(f: &Finding, name: &str, v: f64) -> String {
     match f.units.get(name) {
         Some(u) => with_unit(v, 4, u),
         None => with_unit(v, 4, suffix_unit(name)),
+    }
+}
+
+/// The unit of a candidate's grid value: a saturation level or offset of the input in the
+/// input's unit, a torque saturation level in the output's, else the name's suffix.
+fn grid_unit<'a>(d: &'a Diagnosis, name: &str) -> &'a str {
+    match name {
+        "b_sat" | "b_0" => d.units.0.as_str(),
+        "t_sat" => d.units.1.as_str(),
+        _ => suffix_unit(name),
     }
 }
 
