@@ -14,7 +14,9 @@
 //! finding, not a statistically real but useless one. The diagnosis also asks that what
 //! the term changes in the prediction (RMS) be at least [`MIN_TERM_OF_NOISE`] × the
 //! residual's sample-to-sample noise floor: a change smaller than one sample's noise is
-//! below what the recording resolves, however significant its average.
+//! below what the recording resolves, however significant its average. A term kept as a
+//! finding must gain at least [`MIN_FINDING_GAIN`]; [`MIN_GAIN`] stays the bar of the test
+//! itself (which also compares the contending bases' first rounds).
 
 use serde::Serialize;
 
