@@ -12,7 +12,7 @@
 //! - [`bench_table`] (ignored, about 25 minutes): the full table, per effect and per
 //!   excitation: `BENCH_SET=heldout cargo test --release -p integration-tests --test
 //!   diagnose_concealed -- --ignored --nocapture` (`BENCH_SET=dev` for the development
-//!   seeds, `fresh` … `fresh4` for the second to fifth held-out ranges; `BENCH_N`,
+//!   seeds, `fresh` … `fresh5` for the second to sixth held-out ranges; `BENCH_N`,
 //!   `BENCH_NULL` for the number of effect and null cases, default 256 and 48;
 //!   `BENCH_MIN_FS`, `BENCH_MAX_FS` keep only the cases sampled within those rates, Hz;
 //!   `BENCH_SEEDS=a,b,…` only the cases with those seeds). It prints one line per case and writes
@@ -214,7 +214,7 @@ fn blind_subset_of_heldout_seeds() {
 }
 
 #[test]
-#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2|fresh3|fresh4|dev, BENCH_N, BENCH_NULL"]
+#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh5|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
     let sets = [
         ("dev", Set::Development),
@@ -223,6 +223,7 @@ fn bench_table() {
         ("fresh2", Set::Fresh2),
         ("fresh3", Set::Fresh3),
         ("fresh4", Set::Fresh4),
+        ("fresh5", Set::Fresh5),
     ];
     let key = std::env::var("BENCH_SET").ok();
     let (key, set) = sets.into_iter().find(|(k, _)| key.as_deref() == Some(*k)).unwrap_or(sets[1]);

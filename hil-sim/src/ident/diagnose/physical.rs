@@ -1,6 +1,6 @@
 //! Whether a candidate's fitted values are physically possible: a finding is never a
 //! negative mass or inertia, a time constant or saturation level that is not positive, a
-//! yield-stress saturation that expands the torque instead,
+//! yield-stress saturation that expands the torque instead or turns it down at the top,
 //! or a lag, delay or channel lag pinned at the edge of its search range (the refit
 //! wanted more than the range allows: the term is standing in for something else).
 
@@ -16,11 +16,24 @@ pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64) 
     if c.effect == "inertia" && coef < 0.0 {
         return Some(format!("a negative mass or inertia ({})", crate::numerics::number::num(coef, 4)));
     }
-    if c.grid_name.as_deref() == Some("t_sat") && coef <= 0.0 {
-        return Some(format!(
-            "a torque growing faster, not levelling off, at high level (k = {})",
-            crate::numerics::number::num(coef, 4)
-        ));
+    if c.grid_name.as_deref() == Some("t_sat") {
+        if coef <= 0.0 {
+            return Some(format!(
+                "a torque growing faster, not levelling off, at high level (k = {})",
+                crate::numerics::number::num(coef, 4)
+            ));
+        }
+        // The map `u − k·(u − u/√(1 + (u/T_s)²))` must not turn down over the model's range:
+        // its slope at the top, `1 − k·(1 − (1 + (u/T_s)²)^(−3/2))`, stays ≥ 0.
+        let (lo, hi) = f.model.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+        let r = (hi - lo) / value.max(1e-300);
+        let slope = 1.0 - coef * (1.0 - (1.0 + r * r).powf(-1.5));
+        if slope < 0.0 {
+            return Some(format!(
+                "a saturation that turns the torque down at high level (slope {slope:.2} at the top, k = {})",
+                crate::numerics::number::num(coef, 4)
+            ));
+        }
     }
     let name = c.grid_name.as_deref()?;
     if c.grid.len() < 2 {

@@ -24,7 +24,7 @@
 //! and the torque.
 //!
 //! The seeds are split: [`Set::Development`] draws from one range, [`Set::Heldout`],
-//! [`Set::Fresh`], [`Set::Fresh2`], [`Set::Fresh3`] and [`Set::Fresh4`] from five others; the method is developed on the
+//! [`Set::Fresh`] … [`Set::Fresh5`] from six others; the method is developed on the
 //! first and reported on the others (each first run for one report).
 
 pub mod chain;
@@ -64,6 +64,8 @@ pub enum Set {
     Fresh3,
     /// A fifth held-out range, first run for the report of 2026-11-27.
     Fresh4,
+    /// A sixth held-out range, first run for the second report of 2026-11-27.
+    Fresh5,
 }
 
 impl Set {
@@ -76,6 +78,7 @@ impl Set {
             Set::Fresh2 => 12_700_000 + 13 * k,
             Set::Fresh3 => 15_100_000 + 17 * k,
             Set::Fresh4 => 18_300_000 + 19 * k,
+            Set::Fresh5 => 21_500_000 + 23 * k,
         }
     }
 }
