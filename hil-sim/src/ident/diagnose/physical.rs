@@ -60,3 +60,46 @@ pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64) 
         _ => None,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ident::diagnose::augment::Term;
+    use crate::ident::diagnose::candidates::Piece;
+
+    /// The yield-stress candidate, and a model spanning 0–4 N·m refitted with its term at
+    /// coefficient `k`.
+    fn case(k: f64) -> (Candidate, Fitted) {
+        let c = Candidate {
+            effect: "saturation",
+            label: "saturating torque at high level (yield stress)".into(),
+            grid_name: Some("t_sat".into()),
+            grid: vec![1.0, 10.0],
+            build: Box::new(|t| Piece { transform: None, terms: vec![Term::output_saturation("k_sat", t)] }),
+            channel: None,
+        };
+        let f = Fitted {
+            transforms: vec![],
+            terms: vec![Term::output_saturation("k_sat", 2.0)],
+            theta: vec![],
+            beta: vec![k],
+            model: (0..=100).map(|i| f64::from(i) * 0.04).collect(),
+            pred: vec![],
+            train_mse: 0.0,
+        };
+        (c, f)
+    }
+
+    #[test]
+    fn a_yield_stress_saturation_levels_off_and_never_turns_down() {
+        // Over 4 N·m with T_s = 2 N·m the map's slope at the top is 1 − k·(1 − 5^(−3/2)):
+        // positive for k below 1.1.
+        let why = |k: f64| {
+            let (c, f) = case(k);
+            impossible(&c, &f, 0, 2.0, 1e-3)
+        };
+        assert_eq!(why(1.0), None);
+        assert!(why(1.5).is_some_and(|w| w.contains("turns the torque down")), "{:?}", why(1.5));
+        assert!(why(-0.2).is_some_and(|w| w.contains("growing faster")), "{:?}", why(-0.2));
+    }
+}
