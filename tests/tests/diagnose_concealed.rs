@@ -216,17 +216,9 @@ fn blind_subset_of_heldout_seeds() {
 #[test]
 #[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh5|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
-    let sets = [
-        ("dev", Set::Development),
-        ("heldout", Set::Heldout),
-        ("fresh", Set::Fresh),
-        ("fresh2", Set::Fresh2),
-        ("fresh3", Set::Fresh3),
-        ("fresh4", Set::Fresh4),
-        ("fresh5", Set::Fresh5),
-    ];
+    let sets = Set::NAMED;
     let key = std::env::var("BENCH_SET").ok();
-    let (key, set) = sets.into_iter().find(|(k, _)| key.as_deref() == Some(*k)).unwrap_or(sets[1]);
+    let (key, set) = sets.iter().copied().find(|(k, _)| key.as_deref() == Some(*k)).unwrap_or(sets[1]);
     let n = std::env::var("BENCH_N").ok().and_then(|v| v.parse().ok()).unwrap_or(256);
     let n_null = std::env::var("BENCH_NULL").ok().and_then(|v| v.parse().ok()).unwrap_or(48);
     // BENCH_FROM / BENCH_TO: a slice of the list (to share a run between processes).

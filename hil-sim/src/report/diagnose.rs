@@ -160,14 +160,9 @@ fn value(f: &Finding, name: &str, v: f64) -> String {
     }
 }
 
-/// The unit of a candidate's grid value: a saturation level or offset of the input in the
-/// input's unit, a torque saturation level in the output's, else the name's suffix.
+/// The unit of a candidate's grid value: as its finding would give it, else the name's suffix.
 fn grid_unit<'a>(d: &'a Diagnosis, name: &str) -> &'a str {
-    match name {
-        "b_sat" | "b_0" => d.units.0.as_str(),
-        "t_sat" => d.units.1.as_str(),
-        _ => suffix_unit(name),
-    }
+    crate::ident::diagnose::describe::grid_unit(name, (&d.units.0, &d.units.1)).unwrap_or_else(|| suffix_unit(name))
 }
 
 /// The unit a parameter name carries in its suffix (`tau_s` → s), or `""`.

@@ -109,7 +109,7 @@ impl Term {
             TermKind::Additive => self.values.clone(),
             TermKind::TimesModel => self.values.iter().zip(m).map(|(v, m)| v * m).collect(),
             TermKind::OutputSaturation { t_sat } => {
-                let floor = m.iter().copied().fold(f64::INFINITY, f64::min);
+                let floor = crate::numerics::stats::min_max(m).0;
                 let s = t_sat.max(1e-300);
                 m.iter()
                     .map(|m| {

@@ -22,7 +22,7 @@ use serde::Serialize;
 
 use super::augment::{Fitted, Term, Transform};
 use crate::ident::fit::Dataset;
-use crate::numerics::stats::{mean, std};
+use crate::numerics::stats::{mean, min_max, std};
 
 /// What an auxiliary channel was taken to be.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -231,7 +231,7 @@ impl InputStats {
         let (dx, ddx) = rates(data);
         let x_max = x.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
         let x_span = {
-            let (lo, hi) = x.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+            let (lo, hi) = min_max(&x);
             (hi - lo).max(1e-300)
         };
         let x_mean = mean(&x);
@@ -326,7 +326,7 @@ fn input_transforms(s: &InputStats) -> Vec<Candidate> {
 /// `u = T − T_lo`, whatever the field did (the steel saturating is the input's map above).
 /// `T_s` from 0.3 to 10 output spans; the term's coefficient is ≈ 1 for exactly that map.
 fn yield_saturation(data: &Dataset) -> Candidate {
-    let (lo, hi) = data.output.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+    let (lo, hi) = min_max(&data.output);
     let span = (hi - lo).max(1e-300);
     Candidate {
         effect: "saturation",

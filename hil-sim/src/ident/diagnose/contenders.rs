@@ -46,7 +46,7 @@ fn play(x: &[f64], r: f64) -> Vec<f64> {
 /// model's family has and that no catalog effect is (its width does not grow with the rate,
 /// the level or the temperature).
 pub fn plays(x: &[f64]) -> Vec<Term> {
-    let (lo, hi) = x.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+    let (lo, hi) = crate::numerics::stats::min_max(x);
     let span = if hi > lo { hi - lo } else { 0.0 };
     PLAY_RADII.iter().map(|f| Term::additive(format!("play_{:.0}pct", 100.0 * f), play(x, f * span))).collect()
 }

@@ -99,12 +99,8 @@ pub fn finding(d: &Described<'_>) -> Finding {
     let mut units = BTreeMap::new();
     if let Some(name) = &c.grid_name {
         params.insert(name.clone(), g);
-        if name == "b_sat" || name == "b_0" {
-            units.insert(name.clone(), xu.to_owned());
-        } else if name == "t_sat" {
-            units.insert(name.clone(), yu.to_owned());
-        } else if name.ends_with("_s") {
-            units.insert(name.clone(), "s".to_owned());
+        if let Some(u) = grid_unit(name, (xu, yu)) {
+            units.insert(name.clone(), u.to_owned());
         }
     }
     let n_old = reference.terms.len();
@@ -250,6 +246,18 @@ fn what(d: &Described<'_>) -> String {
             1e3 * g
         ),
         other => other.to_owned(),
+    }
+}
+
+/// The unit of a candidate's grid value `name` (`xu`, `yu`: the input's and the output's
+/// units): a saturation level or offset of the input in the input's, a torque saturation
+/// level in the output's, a time (`…_s`) in s; `None` for any other.
+pub fn grid_unit<'a>(name: &str, (xu, yu): (&'a str, &'a str)) -> Option<&'a str> {
+    match name {
+        "b_sat" | "b_0" => Some(xu),
+        "t_sat" => Some(yu),
+        n if n.ends_with("_s") => Some("s"),
+        _ => None,
     }
 }
 

@@ -262,13 +262,18 @@ mod tests {
         let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
         let x: Vec<f64> = time.iter().map(|&t| x(t)).collect();
         let seen = effect.map_or_else(|| x.clone(), |e| e.apply(&x, dt));
-        // The clutch's physics sees the true rate (here the zero-phase one of the clean input).
-        let rates = crate::numerics::derivative::rates(&seen, dt);
-        let samples = crate::models::replay::samples_with_rates(&seen, None, Some(&rates));
+        let y: Vec<f64> = bouc_wen_truth(&seen, dt).iter().zip(&x).map(|(v, x)| v + extra(*x)).collect();
+        with_noise(x, &y, &mut rng)
+    }
+
+    /// The tests' true clutch, model-core's Bouc–Wen, fed `seen` (sampled every `dt` s) with
+    /// its true rate (here the zero-phase one of the clean input).
+    fn bouc_wen_truth(seen: &[f64], dt: f64) -> Vec<f64> {
+        let rates = crate::numerics::derivative::rates(seen, dt);
+        let samples = crate::models::replay::samples_with_rates(seen, None, Some(&rates));
         let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
         let out = crate::models::replay("bouc_wen", &truth, dt as f32, RateSpec::Backward, &samples).unwrap();
-        let y: Vec<f64> = out.y.iter().zip(&x).map(|(v, x)| f64::from(*v) + extra(*x)).collect();
-        with_noise(x, &y, &mut rng)
+        out.y.iter().map(|v| f64::from(*v)).collect()
     }
 
     /// A 1 kHz dataset of the input `x` and the output `y` with uniform white noise of 0.5 %
@@ -317,12 +322,8 @@ mod tests {
             .map(|i| i as f64 * dt)
             .map(|t| 1.0 + 0.5 * tone(t, 2.0, 0.0) + 0.2 * tone(t, 7.3, 1.0) + 0.1 * tone(t, 13.1, 2.0))
             .collect();
-        let rates = crate::numerics::derivative::rates(&x, dt);
-        let samples = crate::models::replay::samples_with_rates(&x, None, Some(&rates));
-        let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
-        let out = crate::models::replay("bouc_wen", &truth, dt as f32, RateSpec::Backward, &samples).unwrap();
-        let m: Vec<f64> = out.y.iter().map(|v| f64::from(*v)).collect();
-        let (lo, hi) = m.iter().fold((f64::MAX, f64::MIN), |(l, h), v| (l.min(*v), h.max(*v)));
+        let m = bouc_wen_truth(&x, dt);
+        let (lo, hi) = crate::numerics::stats::min_max(&m);
         let s = 1.5 * (hi - lo);
         let y: Vec<f64> = m.iter().map(|v| lo + (v - lo) / (1.0 + ((v - lo) / s).powi(2)).sqrt()).collect();
         let change = (m.iter().zip(&y).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / m.len() as f64).sqrt();

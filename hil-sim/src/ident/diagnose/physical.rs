@@ -25,7 +25,7 @@ pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64) 
         }
         // The map `u − k·(u − u/√(1 + (u/T_s)²))` must not turn down over the model's range:
         // its slope at the top, `1 − k·(1 − (1 + (u/T_s)²)^(−3/2))`, stays ≥ 0.
-        let (lo, hi) = f.model.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(*v), h.max(*v)));
+        let (lo, hi) = crate::numerics::stats::min_max(&f.model);
         let r = (hi - lo) / value.max(1e-300);
         let slope = 1.0 - coef * (1.0 - (1.0 + r * r).powf(-1.5));
         if slope < 0.0 {

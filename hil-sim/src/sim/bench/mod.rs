@@ -69,6 +69,17 @@ pub enum Set {
 }
 
 impl Set {
+    /// Every set, by the name `BENCH_SET` gives it.
+    pub const NAMED: &'static [(&'static str, Set)] = &[
+        ("dev", Set::Development),
+        ("heldout", Set::Heldout),
+        ("fresh", Set::Fresh),
+        ("fresh2", Set::Fresh2),
+        ("fresh3", Set::Fresh3),
+        ("fresh4", Set::Fresh4),
+        ("fresh5", Set::Fresh5),
+    ];
+
     /// The seed of case `k` of this set.
     pub fn seed(self, k: u64) -> u64 {
         match self {
