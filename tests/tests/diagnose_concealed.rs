@@ -12,10 +12,11 @@
 //! - [`bench_table`] (ignored, about 25 minutes): the full table, per effect and per
 //!   excitation: `BENCH_SET=heldout cargo test --release -p integration-tests --test
 //!   diagnose_concealed -- --ignored --nocapture` (`BENCH_SET=dev` for the development
-//!   seeds, `fresh` … `fresh5` for the second to sixth held-out ranges; `BENCH_N`,
+//!   seeds, `fresh` … `fresh6` for the second to seventh held-out ranges; `BENCH_N`,
 //!   `BENCH_NULL` for the number of effect and null cases, default 256 and 48;
 //!   `BENCH_MIN_FS`, `BENCH_MAX_FS` keep only the cases sampled within those rates, Hz;
-//!   `BENCH_SEEDS=a,b,…` only the cases with those seeds). It prints one line per case and writes
+//!   `BENCH_SEEDS=a,b,…` only the cases with those seeds; `BENCH_WRITE=DIR` writes each case's
+//!   recording to `DIR/<seed>.csv`, to diagnose it by hand). It prints one line per case and writes
 //!   `target/bench_<set>.md`; `BENCH_DUMP=FILE` appends a JSON line per case (the case,
 //!   the findings, every candidate tested with its statistics) for studying a decision rule
 //!   offline.
@@ -52,6 +53,11 @@ impl Outcome {
 
 fn run(c: &Case) -> Outcome {
     let g = generate(c).unwrap_or_else(|e| panic!("{c:?}: {e}"));
+    if let Ok(dir) = std::env::var("BENCH_WRITE") {
+        let path = std::path::Path::new(&dir).join(format!("{}.csv", c.seed));
+        let file = std::fs::File::create(&path).unwrap_or_else(|e| panic!("BENCH_WRITE {}: {e}", path.display()));
+        g.recording.write_csv(std::io::BufWriter::new(file)).expect("BENCH_WRITE");
+    }
     let ch = Channels::default();
     let prepared = prepare_recording(g.recording, &ch, 0.7, false).expect("dataset");
     let (rec, data) = (&prepared.recording, &prepared.data);
@@ -214,7 +220,7 @@ fn blind_subset_of_heldout_seeds() {
 }
 
 #[test]
-#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh5|dev, BENCH_N, BENCH_NULL"]
+#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh6|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
     let sets = Set::NAMED;
     let key = std::env::var("BENCH_SET").ok();

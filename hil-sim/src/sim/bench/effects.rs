@@ -7,7 +7,7 @@
 //! | `field_lag` | first-order lag `τ·ḃ_f = b − b_f`; two poles `τ/2` each; an eddy share `0.3·b + 0.7·b_f` |
 //! | `transport_delay` | the torque responds `d` late (`b(t − d)`); the Hall channel is logged `d` late (fractional, cubic interpolation) |
 //! | `saturation` | of the field `b_s·tanh(b/b_s)`; of the field, sharper knee `b/(1 + (b/b_s)⁴)^¼`; of the yield stress `T_lo + u/√(1 + (u/S)²)` |
-//! | `rate_dependence` | `c·|ḃ|·ḃ`; a damping coefficient growing with the local excitation frequency `c·f_loc(t)·ḃ`; `c·ḃ³` |
+//! | `rate_dependence` | `c·|ḃ|·ḃ`; a damping coefficient growing with the local excitation frequency `c·f_loc(t)·ḃ`; `c·ḃ³` (sized by the part beyond a linear damping `c·ḃ`) |
 //! | `asymmetry` | `δ·(b − b̄)·tanh(ḃ/ε)`; loading branch only `δ·(b − b_min)·(1 + tanh(ḃ/ε))/2`; quadratic `δ·(b − b̄)²·tanh(ḃ/ε)` |
 //! | `thermal_drift` | the heating state `θ` (driven by the slip power `|T·ω|`) scales the torque `T·(1 − κ·θ)`; shifts it `−κ·θ` (off-state drift); lowers the yield part `−κ·θ·(T − T_lo)` |
 //! | `slip_speed` | `c_ω·ω`; `c_ω·ω·b/b_max`; `c_ω·√ω` |
@@ -141,12 +141,38 @@ pub fn apply(w: &World, effect: &str, form: usize, size: f64) -> Applied {
                 Applied { torque: w.base.clone(), b_reported, form: "Hall channel late".into(), params, effect_rms }
             }
         }
+        "rate_dependence" => {
+            // The catalog's rate dependence is what goes beyond the linear `c·ḃ` every base
+            // has: the term is added whole, its strength set by the part a refitted linear
+            // damping cannot take (the least-squares share along `ḃ` taken out).
+            let (shape, name, label) = term_shape(w, effect, form);
+            let beyond = beyond_linear_damping(&shape, &w.db);
+            let k = target / rms_about_mean(&beyond).max(1e-300);
+            let torque = w.base.iter().zip(&shape).map(|(t, s)| t + k * s).collect();
+            Applied {
+                torque,
+                b_reported: w.b.clone(),
+                form: label.into(),
+                params: BTreeMap::from([(name.to_owned(), k)]),
+                effect_rms: k * rms_about_mean(&beyond),
+            }
+        }
         _ => {
             let (shape, name, label) = term_shape(w, effect, form);
             let (torque, params) = additive(w, shape, target, name);
             unchanged(torque, label, params)
         }
     }
+}
+
+/// `shape` less its least-squares share along the rate `db` (both about their means).
+fn beyond_linear_damping(shape: &[f64], db: &[f64]) -> Vec<f64> {
+    let n = shape.len().max(1) as f64;
+    let (ms, md) = (shape.iter().sum::<f64>() / n, db.iter().sum::<f64>() / n);
+    let (sd, dd) =
+        shape.iter().zip(db).fold((0.0, 0.0), |(sd, dd), (s, d)| (sd + (s - ms) * (d - md), dd + (d - md) * (d - md)));
+    let beta = if dd > 0.0 { sd / dd } else { 0.0 };
+    shape.iter().zip(db).map(|(s, d)| (s - ms) - beta * (d - md)).collect()
 }
 
 /// The shape (torque change at unit strength) of a term effect's form.

@@ -66,6 +66,9 @@ pub enum Set {
     Fresh4,
     /// A sixth held-out range, first run for the second report of 2026-11-27.
     Fresh5,
+    /// A seventh held-out range, first run for the third report of 2026-11-27 (the bench's
+    /// blocks without jumps, rate dependence sized beyond a linear damping).
+    Fresh6,
 }
 
 impl Set {
@@ -78,6 +81,7 @@ impl Set {
         ("fresh3", Set::Fresh3),
         ("fresh4", Set::Fresh4),
         ("fresh5", Set::Fresh5),
+        ("fresh6", Set::Fresh6),
     ];
 
     /// The seed of case `k` of this set.
@@ -90,6 +94,7 @@ impl Set {
             Set::Fresh3 => 15_100_000 + 17 * k,
             Set::Fresh4 => 18_300_000 + 19 * k,
             Set::Fresh5 => 21_500_000 + 23 * k,
+            Set::Fresh6 => 25_300_000 + 29 * k,
         }
     }
 }

@@ -21,7 +21,7 @@ pub fn gauss(rng: &mut impl Rng) -> f64 {
 /// - `sweep`: a logarithmic swept sine 0.5 → 12 Hz, swept up and back down so that both
 ///   halves of the recording see every frequency (seed 002);
 /// - `blocks`: blocks of 2–4 s, each a sine of 1 to 9 Hz (whole hertz) with a random
-///   amplitude between 0.5 and 1, joined at zero crossings of the phase (seed 001's tests);
+///   amplitude between 0.5 and 1, joined at zero crossings of the sine (seed 001's tests);
 /// - `noise`: white noise through a fourth-order low-pass at 4–10 Hz (zero phase), the
 ///   band-limited random excitation of seed 000.
 pub fn excitation(name: &str, t: &[f64], dur: f64, dt: f64, rng: &mut impl Rng) -> Vec<f64> {
@@ -45,15 +45,21 @@ pub fn excitation(name: &str, t: &[f64], dur: f64, dt: f64, rng: &mut impl Rng) 
                 .collect()
         }
         "blocks" => {
+            // A block ends at the first zero crossing of its sine after its 2–4 s: the next
+            // starts from phase 0, so the field never jumps (only its slope changes).
             let mut out = Vec::with_capacity(t.len());
             let (mut f, mut a, mut until, mut phase) = (0.0, 0.0, -1.0, 0.0);
             for tk in t {
-                if *tk >= until {
+                let next = phase + 2.0 * PI * f * dt;
+                let crossed = (next / PI).floor() > (phase / PI).floor();
+                if *tk >= until && (crossed || f == 0.0) {
                     f = f64::from(rng.random_range(1..=9));
                     a = rng.random_range(0.5..1.0);
                     until = tk + rng.random_range(2.0..4.0);
+                    phase = 0.0;
+                } else {
+                    phase = next;
                 }
-                phase += 2.0 * PI * f * dt;
                 out.push(a * phase.sin());
             }
             out

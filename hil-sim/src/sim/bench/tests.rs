@@ -42,3 +42,42 @@ fn the_label_stays_out_of_the_recording() {
     assert_eq!(&names[..5], &["t", "b", "torque", "i", "speed"]);
     assert!(generate(&c).unwrap().recording.columns[2].values == g.recording.columns[2].values);
 }
+
+#[test]
+fn blocks_join_without_a_jump_in_the_field() {
+    let dt = 1e-3;
+    let t: Vec<f64> = (0..20_000).map(|k| k as f64 * dt).collect();
+    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+    let s = signals::excitation("blocks", &t, 20.0, dt, &mut rng);
+    // Normalised to [−1, 1] from amplitudes of at least 0.5: a slope of at most 2·2π·9 per s.
+    let steepest = 2.0 * 2.0 * PI * 9.0 * dt;
+    let worst = s.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
+    assert!(worst <= 1.01 * steepest, "a step of {worst} between samples (slope bound {steepest})");
+}
+
+#[test]
+fn rate_dependence_is_sized_beyond_a_linear_damping() {
+    for form in 0..3 {
+        let c = Case {
+            form,
+            duration_s: 6.0,
+            fs_hz: 1000.0,
+            size: 0.05,
+            ..Case::draw("rate_dependence", "bouc_wen", "multisine", 7)
+        };
+        let mut rng = rand::rngs::StdRng::seed_from_u64(c.seed);
+        let w = World::new(&c, &mut rng).unwrap();
+        let a = effects::apply(&w, "rate_dependence", form, c.size);
+        let change: Vec<f64> = a.torque.iter().zip(&w.base).map(|(t, b)| t - b).collect();
+        // What a refitted c·ḃ and offset leave of the change, by ordinary least squares.
+        let x = nalgebra::DMatrix::from_fn(change.len(), 2, |i, j| if j == 0 { 1.0 } else { w.db[i] });
+        let y = nalgebra::DVector::from_column_slice(&change);
+        let fit = x.clone().svd(true, true).solve(&y, 1e-12).unwrap();
+        let left = (&y - &x * fit).norm() / (change.len() as f64).sqrt();
+        assert!((left / w.span - 0.05).abs() < 0.002, "form {form}: {} of the span beyond c·ḃ", left / w.span);
+        assert!(
+            signals::rms_about_mean(&change) > left,
+            "form {form}: the whole term is larger than its part beyond c·ḃ"
+        );
+    }
+}
