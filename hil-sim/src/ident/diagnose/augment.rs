@@ -130,6 +130,9 @@ pub struct Problem<'a> {
     pub rate: RateSpec,
     /// Training rows the refit uses (flagged samples and delay-uncovered edges left out).
     pub train: Vec<usize>,
+    /// Cutoff (Hz) of the zero-phase rate of the given rates
+    /// ([`crate::numerics::derivative::content_cutoff`]): a transformed input gets its rate the same way.
+    pub rate_cutoff_hz: f64,
 }
 
 /// A refitted augmented model.
@@ -264,7 +267,11 @@ impl Problem<'_> {
             x = t.apply(&x, self.data.dt);
         }
         // Given rates are the zero-phase ones: recomputed for the transformed input.
-        let rates = self.data.rates.as_ref().map(|_| crate::numerics::derivative::rates(&x, self.data.dt));
+        let rates = self
+            .data
+            .rates
+            .as_ref()
+            .map(|_| crate::numerics::derivative::rates_below(&x, self.data.dt, self.rate_cutoff_hz));
         let samples = crate::models::replay::samples_with_rates(&x, self.data.command.as_deref(), rates.as_ref());
         kinematics(&samples, self.data.dt as f32, self.rate)
     }

@@ -79,6 +79,8 @@ pub struct Shared<'a, 'b> {
     pub cands: &'b [Candidate],
     pub rate: &'b [f64],
     pub aux: &'b [(&'b str, &'b [f64])],
+    /// Cutoff (Hz) of the input's zero-phase rate.
+    pub rate_cutoff_hz: f64,
 }
 
 /// The first round on `base`, with play operators when `with_plays`.
@@ -90,6 +92,7 @@ pub fn open<'a>(base: &'a Base, s: &Shared<'a, '_>, with_plays: bool) -> Result<
         spec: &base.spec,
         rate: base.fit.rate_choice,
         train: s.train.to_vec(),
+        rate_cutoff_hz: s.rate_cutoff_hz,
     };
     // Run on from the fit until it stalls, so that a term is never credited with what more
     // iterations of the base would have done.

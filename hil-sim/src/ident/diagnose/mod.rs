@@ -109,8 +109,9 @@ fn diagnose_at_rate(
     // Without a chosen estimator the models get the zero-phase rate: a causal estimator's
     // lag would otherwise be diagnosed as the clutch's.
     let mut data = data.clone();
+    let rate_cutoff_hz = crate::numerics::derivative::content_cutoff(&data.input, data.dt);
     if opts.rate.is_none() {
-        data.rates = Some(crate::numerics::derivative::rates(&data.input, data.dt));
+        data.rates = Some(crate::numerics::derivative::rates_below(&data.input, data.dt, rate_cutoff_hz));
     }
     let data = &data;
     let bases = base::choices(opts);
@@ -129,10 +130,27 @@ fn diagnose_at_rate(
     let judge0 = Judge { y: &data.output, held: &held, rows: &all_rows, noise_rms: 0.0, dt: data.dt };
     progress.advance(1);
     progress.message("round 1: naming");
-    let shared = contenders::Shared { data, train: &train, judge: &judge0, cands: &cands, rate: &dx, aux: &aux_refs };
+    let shared = contenders::Shared {
+        data,
+        train: &train,
+        judge: &judge0,
+        cands: &cands,
+        rate: &dx,
+        aux: &aux_refs,
+        rate_cutoff_hz,
+    };
     let mut openings = contenders::open_all(&fitted, &shared)?;
     let chosen = contenders::choose(&openings, &judge0);
     let mut notes = fitted.failed.clone();
+    let top_hz = crate::numerics::derivative::CUTOFF_OF_FS / data.dt;
+    if opts.rate.is_none() && rate_cutoff_hz < top_hz {
+        notes.push(format!(
+            "the models' rate of {i} was smoothed (zero phase) at {rate_cutoff_hz:.0} Hz, not {top_hz:.0} Hz: 99.9 % of \
+             {i}'s power lies below {:.1} Hz, and the band above it only adds the reading's noise to the rate",
+            rate_cutoff_hz / crate::numerics::derivative::CUTOFF_OF_CONTENT,
+            i = names.0
+        ));
+    }
     notes.extend(contenders::notes(&openings, chosen, &judge0, &cands, names));
     let contenders::Opening { base, before, prob, mut current, located, first, .. } = openings.swap_remove(chosen);
     let id = base.fit.model.clone();

@@ -31,6 +31,7 @@ pub fn starts(prob: &Problem<'_>, c: &Candidate, current: &Fitted) -> Vec<Start>
         spec: prob.spec,
         rate: prob.rate,
         train: prob.train.iter().copied().take_while(|&i| i < PROFILE_SAMPLES).collect(),
+        rate_cutoff_hz: prob.rate_cutoff_hz,
     };
     let prob = if short.train.len() >= 1000 { &short } else { prob };
     let profile: Vec<(f64, f64, Option<Vec<f64>>)> = continuation_chains(c, &prob.data.input, prob.data.dt)

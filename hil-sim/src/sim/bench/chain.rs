@@ -43,3 +43,43 @@ pub fn record(w: &World, a: &Applied, c: &Case, rng: &mut impl Rng) -> Recording
     }
     Recording::from_columns(Path::new("bench.csv"), columns, Vec::new())
 }
+
+#[cfg(test)]
+mod probe_tmp {
+    use super::*;
+    #[test]
+    #[ignore]
+    fn probe_null_variants() {
+        let seed: u64 = std::env::var("PSEED").unwrap().parse().unwrap();
+        let fam = std::env::var("PFAM").unwrap();
+        let exc = std::env::var("PEXC").unwrap();
+        let c = Case::draw("none", &fam, &exc, seed);
+        let mut rng = <rand::rngs::StdRng as rand::SeedableRng>::seed_from_u64(c.seed);
+        let w = World::new(&c, &mut rng).unwrap();
+        let dt = w.dt;
+        let noise = 0.005 * w.span;
+        let fc = 200.0f64.min(0.2 * c.fs_hz);
+        for (name, filt, quant, noisy) in [
+            ("A", true, true, true),
+            ("B", false, true, true),
+            ("C", true, false, true),
+            ("D", false, false, true),
+            ("E", true, false, false),
+        ] {
+            let b_adc: Vec<f64> =
+                w.b.iter().map(|v| if quant { adc(*v, 1.0, 12, 0.5, &mut rng) } else { *v }).collect();
+            let t_adc: Vec<f64> =
+                w.base.iter().map(|v| v + if noisy { noise * gauss(&mut rng) } else { 0.0 }).collect();
+            let (b_rec, t_rec) = if filt {
+                (butter2_zero_phase(&b_adc, fc, dt), butter2_zero_phase(&t_adc, fc, dt))
+            } else {
+                (b_adc, t_adc)
+            };
+            let mut s = String::from("t,b,torque\n");
+            for k in 0..w.t.len() {
+                s += &format!("{},{},{}\n", w.t[k], b_rec[k], t_rec[k]);
+            }
+            std::fs::write(format!("/tmp/probe/{name}.csv"), s).unwrap();
+        }
+    }
+}

@@ -69,6 +69,9 @@ pub enum Set {
     /// A seventh held-out range, first run for the third report of 2026-11-27 (the bench's
     /// blocks without jumps, rate dependence sized beyond a linear damping).
     Fresh6,
+    /// An eighth held-out range, first run for the fourth report of 2026-11-27 (the rate
+    /// smoothed at the input's content).
+    Fresh7,
 }
 
 impl Set {
@@ -82,6 +85,7 @@ impl Set {
         ("fresh4", Set::Fresh4),
         ("fresh5", Set::Fresh5),
         ("fresh6", Set::Fresh6),
+        ("fresh7", Set::Fresh7),
     ];
 
     /// The seed of case `k` of this set.
@@ -95,6 +99,7 @@ impl Set {
             Set::Fresh4 => 18_300_000 + 19 * k,
             Set::Fresh5 => 21_500_000 + 23 * k,
             Set::Fresh6 => 25_300_000 + 29 * k,
+            Set::Fresh7 => 29_900_000 + 31 * k,
         }
     }
 }
