@@ -355,6 +355,34 @@ mod tests {
     }
 
     #[test]
+    fn a_steep_rate_term_read_through_a_12_bit_hall_is_not_a_lag() {
+        // Kwok's tanh clutch (seed 000 eq. 11–12: the `tanh` base itself, nothing missing)
+        // under band-limited noise, its field read by a 12-bit ADC over ±1 T with half a count
+        // of noise. Differentiated at fs/8, the reading's steps jittered tanh(β·ḃ) around
+        // ḃ = 0, and a 2–4 ms lag of the input, which smooths them, was named.
+        let mut rng = rand::rngs::StdRng::seed_from_u64(21);
+        let (dt, n) = (1e-3, 20_000);
+        let mut white: Vec<f64> = (0..n).map(|_| rng.random::<f64>() - 0.5).collect();
+        for _ in 0..4 {
+            white = crate::numerics::derivative::filtfilt(&white, 1.0 / (2.0 * std::f64::consts::PI * 6.0 * dt));
+        }
+        let peak = white.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let b: Vec<f64> = white.iter().map(|v| 0.3 + 0.25 * v / peak).collect();
+        let db = crate::numerics::derivative::gradient(&b, dt);
+        let y: Vec<f64> = b.iter().zip(&db).map(|(b, d)| 0.8 + 22.0 * b + 0.01 * d + 1.5 * (0.6 * d).tanh()).collect();
+        let step = 2.0 / 4096.0;
+        let read: Vec<f64> = b
+            .iter()
+            .map(|v| ((v + 0.5 * step * (rng.random::<f64>() - 0.5) * 12f64.sqrt()) / step).round() * step)
+            .collect();
+        let data = with_noise(read, &y, &mut rng);
+        let opts = DiagnoseOptions { model: Some("tanh".into()), ..Default::default() };
+        let d = diagnose(&data, vec![], None, ("b", "torque"), &opts, &crate::progress::NoProgress).unwrap();
+        assert!(d.findings.is_empty(), "{:#?}", d.findings);
+        assert!(d.notes.iter().any(|n| n.contains("smoothed (zero phase)")), "{:?}", d.notes);
+    }
+
+    #[test]
     fn nothing_missing_gives_no_finding() {
         let d = run(&recording(None, 2));
         assert!(d.findings.is_empty(), "{:#?}", d.findings);
