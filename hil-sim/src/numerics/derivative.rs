@@ -67,7 +67,7 @@ pub const CONTENT_SHARE: f64 = 0.999;
 pub fn content_frequency(x: &[f64], dt: f64) -> Option<f64> {
     use rustfft::num_complex::Complex;
     let n = x.len();
-    if n < 16 || !(dt > 0.0) {
+    if n < 16 || dt.is_nan() || dt <= 0.0 {
         return None;
     }
     let nf = n as f64;
