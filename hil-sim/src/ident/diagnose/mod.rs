@@ -108,11 +108,7 @@ fn diagnose_at_rate(
     let started = Instant::now();
     // Without a chosen estimator the models get the zero-phase rate: a causal estimator's
     // lag would otherwise be diagnosed as the clutch's.
-    let mut data = data.clone();
-    let rate_cutoff_hz = crate::numerics::derivative::content_cutoff(&data.input, data.dt);
-    if opts.rate.is_none() {
-        data.rates = Some(crate::numerics::derivative::rates_below(&data.input, data.dt, rate_cutoff_hz));
-    }
+    let (data, rate_cutoff_hz, rate_note) = with_zero_phase_rate(data, opts, names.0);
     let data = &data;
     let bases = base::choices(opts);
     progress.stage("diagnosing", (bases.len() + 2 + 2 * opts.max_findings) as u64);
@@ -141,16 +137,7 @@ fn diagnose_at_rate(
     };
     let mut openings = contenders::open_all(&fitted, &shared)?;
     let chosen = contenders::choose(&openings, &judge0);
-    let mut notes = fitted.failed.clone();
-    let top_hz = crate::numerics::derivative::CUTOFF_OF_FS / data.dt;
-    if opts.rate.is_none() && rate_cutoff_hz < top_hz {
-        notes.push(format!(
-            "the models' rate of {i} was smoothed (zero phase) at {rate_cutoff_hz:.0} Hz, not {top_hz:.0} Hz: 99.9 % of \
-             {i}'s power lies below {:.1} Hz, and the band above it only adds the reading's noise to the rate",
-            rate_cutoff_hz / crate::numerics::derivative::CUTOFF_OF_CONTENT,
-            i = names.0
-        ));
-    }
+    let mut notes: Vec<String> = fitted.failed.iter().cloned().chain(rate_note).collect();
     notes.extend(contenders::notes(&openings, chosen, &judge0, &cands, names));
     let contenders::Opening { base, before, prob, mut current, located, first, .. } = openings.swap_remove(chosen);
     let id = base.fit.model.clone();
@@ -221,17 +208,45 @@ fn diagnose_at_rate(
         notes,
         units: (unit_of(names.0).unwrap_or("").to_owned(), unit_of(names.1).unwrap_or("").to_owned()),
         seconds: started.elapsed().as_secs_f64(),
-        plot: PlotData {
-            time: data.time.clone(),
-            input: data.input.clone(),
-            output: data.output.clone(),
-            before,
-            after: current.pred,
-            train_end: data.train_end,
-            heldout_rows: held,
-            fs: 1.0 / data.dt,
-        },
+        plot: plot_data(data, before, current.pred, held),
     })
+}
+
+/// What the report plots: the recording, the base's prediction `before` and the final one
+/// `after`, the held-out rows.
+fn plot_data(data: &Dataset, before: Vec<f64>, after: Vec<f64>, held: Vec<usize>) -> PlotData {
+    PlotData {
+        time: data.time.clone(),
+        input: data.input.clone(),
+        output: data.output.clone(),
+        before,
+        after,
+        train_end: data.train_end,
+        heldout_rows: held,
+        fs: 1.0 / data.dt,
+    }
+}
+
+/// `data` with the models' zero-phase rate at [`crate::numerics::derivative::content_cutoff`]
+/// (unless `opts` chose an estimator), that cutoff (Hz), and the note saying so when it is
+/// below fs/8 (`input`: the input channel's name).
+fn with_zero_phase_rate(data: &Dataset, opts: &DiagnoseOptions, input: &str) -> (Dataset, f64, Option<String>) {
+    use crate::numerics::derivative::{content_cutoff, rates_below, CUTOFF_OF_CONTENT, CUTOFF_OF_FS};
+    let mut data = data.clone();
+    let cutoff = content_cutoff(&data.input, data.dt);
+    if opts.rate.is_some() {
+        return (data, cutoff, None);
+    }
+    data.rates = Some(rates_below(&data.input, data.dt, cutoff));
+    let top = CUTOFF_OF_FS / data.dt;
+    let note = (cutoff < top).then(|| {
+        format!(
+            "the models' rate of {input} was smoothed (zero phase) at {cutoff:.0} Hz, not {top:.0} Hz: 99.9 % of \
+             {input}'s power lies below {:.1} Hz, and the band above it only adds the reading's noise to the rate",
+            cutoff / CUTOFF_OF_CONTENT
+        )
+    });
+    (data, cutoff, note)
 }
 
 /// The note of a round (1-based) whose base `id` could not be differentiated.
