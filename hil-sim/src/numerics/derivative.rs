@@ -71,7 +71,7 @@ pub fn content_frequency(x: &[f64], dt: f64) -> Option<f64> {
         return None;
     }
     let nf = n as f64;
-    let (mt, mx) = ((nf - 1.0) / 2.0, x.iter().sum::<f64>() / nf);
+    let (mt, mx) = ((nf - 1.0) / 2.0, crate::numerics::stats::mean(x));
     let (sxy, sxx) = x.iter().enumerate().fold((0.0, 0.0), |(a, b), (i, v)| {
         let d = i as f64 - mt;
         (a + d * (v - mx), b + d * d)

@@ -233,12 +233,13 @@ fn plot_data(data: &Dataset, before: Vec<f64>, after: Vec<f64>, held: Vec<usize>
 fn with_zero_phase_rate(data: &Dataset, opts: &DiagnoseOptions, input: &str) -> (Dataset, f64, Option<String>) {
     use crate::numerics::derivative::{content_cutoff, rates_below, CUTOFF_OF_CONTENT, CUTOFF_OF_FS};
     let mut data = data.clone();
-    let cutoff = content_cutoff(&data.input, data.dt);
-    if opts.rate.is_some() {
-        return (data, cutoff, None);
-    }
-    data.rates = Some(rates_below(&data.input, data.dt, cutoff));
     let top = CUTOFF_OF_FS / data.dt;
+    if opts.rate.is_some() {
+        // The models use the chosen estimator: no given rates, so the cutoff is never read.
+        return (data, top, None);
+    }
+    let cutoff = content_cutoff(&data.input, data.dt);
+    data.rates = Some(rates_below(&data.input, data.dt, cutoff));
     let note = (cutoff < top).then(|| {
         format!(
             "the models' rate of {input} was smoothed (zero phase) at {cutoff:.0} Hz, not {top:.0} Hz: 99.9 % of \
