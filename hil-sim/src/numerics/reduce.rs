@@ -52,7 +52,7 @@ pub fn reduced(j: &DMatrix<f64>, r: &[f64]) -> DMatrix<f64> {
 
 /// `Σ aᵢ·bᵢ` in eight independent partial sums (vectorised, and the same on every machine:
 /// the order of the additions is fixed).
-fn dot(a: &[f64], b: &[f64]) -> f64 {
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
     let (ra, rb) = (ca.remainder(), cb.remainder());
     let mut acc = [0.0f64; 8];

@@ -24,6 +24,7 @@ use crate::ident::fit::Dataset;
 use crate::models::search::{ModelSpec, Spacing};
 use crate::models::RateSpec;
 use crate::numerics::lstsq;
+use crate::numerics::reduce::dot;
 
 /// A change to what the base model is fed.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -104,9 +105,10 @@ impl Term {
     pub fn output_saturation(name: impl Into<String>, t_sat: f64) -> Self {
         Self { name: name.into(), values: Vec::new(), kind: TermKind::OutputSaturation { t_sat } }
     }
-    fn column(&self, m: &[f64]) -> Vec<f64> {
-        match self.kind {
-            TermKind::Additive => self.values.clone(),
+    fn column(&self, m: &[f64]) -> std::borrow::Cow<'_, [f64]> {
+        use std::borrow::Cow;
+        Cow::Owned(match self.kind {
+            TermKind::Additive => return Cow::Borrowed(&self.values),
             TermKind::TimesModel => self.values.iter().zip(m).map(|(v, m)| v * m).collect(),
             TermKind::OutputSaturation { t_sat } => {
                 let floor = crate::numerics::stats::min_max(m).0;
@@ -118,7 +120,7 @@ impl Term {
                     })
                     .collect()
             }
-        }
+        })
     }
 }
 
@@ -179,9 +181,13 @@ struct AugSim<'p, 'a> {
     transforms: &'p [Transform],
     terms: &'p [Term],
     tune: Option<&'p Tune<'p>>,
-    /// Kinematics and the candidate's terms for the last `g` asked for.
-    cache: std::sync::Mutex<Option<CachedPiece>>,
+    /// Kinematics and the candidate's terms for the last [`CACHED`] values of `g` asked for
+    /// (a Jacobian asks for `g` and `g + h` side by side), the latest first.
+    cache: std::sync::Mutex<Vec<CachedPiece>>,
 }
+
+/// Tuning values whose kinematics an [`AugSim`] keeps.
+const CACHED: usize = 2;
 
 /// Kinematics, transforms and terms at one tuning value.
 type Piece = (Vec<model_core::Kin>, Vec<Transform>, Vec<Term>);
@@ -196,8 +202,7 @@ impl AugSim<'_, '_> {
     /// Kinematics, transforms and terms at `g`.
     fn at(&self, g: f64) -> Option<std::sync::Arc<Piece>> {
         if let Ok(c) = self.cache.lock() {
-            if let Some((k, v)) = c.as_ref().filter(|(k, _)| *k == g.to_bits()) {
-                let _ = k;
+            if let Some((_, v)) = c.iter().find(|(k, _)| *k == g.to_bits()) {
                 return Some(std::sync::Arc::clone(v));
             }
         }
@@ -211,7 +216,8 @@ impl AugSim<'_, '_> {
         let kin = self.prob.kin(&transforms)?;
         let v = std::sync::Arc::new((kin, transforms, terms));
         if let Ok(mut c) = self.cache.lock() {
-            *c = Some((g.to_bits(), std::sync::Arc::clone(&v)));
+            c.insert(0, (g.to_bits(), std::sync::Arc::clone(&v)));
+            c.truncate(CACHED);
         }
         Some(v)
     }
@@ -306,55 +312,50 @@ impl Problem<'_> {
     /// Columns are scaled to unit norm and the normal equations get a tiny ridge, so a
     /// column that duplicates another costs nothing instead of breaking the solve.
     pub fn lsq(&self, columns: &[&[f64]], target: &[f64], rows: &[usize]) -> Option<(Vec<f64>, f64)> {
-        let k = columns.len();
         let n = rows.len().max(1) as f64;
-        if k == 0 {
-            let mse = rows.iter().map(|&i| target[i] * target[i]).sum::<f64>() / n;
-            return Some((Vec::new(), mse));
+        let on_rows = |c: &[f64]| -> Vec<f64> { rows.iter().map(|&i| c[i]).collect() };
+        let t = on_rows(target);
+        if columns.is_empty() {
+            return Some((Vec::new(), dot(&t, &t) / n));
         }
-        let norms: Vec<f64> = columns
+        // The columns on the rows, each scaled to unit norm, and their norms.
+        let scaled: Vec<(Vec<f64>, f64)> = columns
             .iter()
-            .map(|c| rows.iter().map(|&i| c[i] * c[i]).sum::<f64>().sqrt())
-            .map(|s| if s > 0.0 && s.is_finite() { s } else { 1.0 })
+            .map(|c| {
+                let v = on_rows(c);
+                let s = dot(&v, &v).sqrt();
+                let s = if s > 0.0 && s.is_finite() { s } else { 1.0 };
+                (v.into_iter().map(|x| x / s).collect(), s)
+            })
             .collect();
-        let mut g = nalgebra::DMatrix::<f64>::zeros(k, k);
-        let mut b = nalgebra::DVector::<f64>::zeros(k);
-        let mut row = vec![0.0; k];
-        for &i in rows {
-            for (r, (c, s)) in row.iter_mut().zip(columns.iter().zip(&norms)) {
-                *r = c[i] / s;
-            }
-            lstsq::accumulate(&mut g, &mut b, &row, target[i]);
-        }
-        lstsq::symmetrize(&mut g);
-        for a in 0..k {
-            g[(a, a)] += 1e-10;
-        }
+        let k = scaled.len();
+        let g = nalgebra::DMatrix::<f64>::from_fn(k, k, |a, b| {
+            dot(&scaled[a].0, &scaled[b].0) + if a == b { 1e-10 } else { 0.0 }
+        });
+        let b = nalgebra::DVector::<f64>::from_fn(k, |a, _| dot(&scaled[a].0, &t));
         let sol = lstsq::solve_cholesky(g, &b, 1e-12)?;
-        let coef: Vec<f64> = sol.iter().zip(&norms).map(|(v, s)| v / s).collect();
+        let coef: Vec<f64> = sol.iter().zip(&scaled).map(|(v, (_, s))| v / s).collect();
         if coef.iter().any(|v| !v.is_finite()) {
             return None;
         }
-        let mse = rows
-            .iter()
-            .map(|&i| {
-                let f: f64 = columns.iter().zip(&coef).map(|(c, w)| c[i] * w).sum();
-                (target[i] - f).powi(2)
-            })
-            .sum::<f64>()
-            / n;
-        Some((coef, mse))
+        let mut r = t;
+        for ((c, _), w) in scaled.iter().zip(sol.iter()) {
+            for (r, c) in r.iter_mut().zip(c) {
+                *r -= w * c;
+            }
+        }
+        Some((coef, dot(&r, &r) / n))
     }
 
     /// β for fixed θ (model output `m`): least squares of `y − m` on the terms' columns.
     fn solve_terms(&self, terms: &[Term], m: &[f64]) -> Option<(Vec<f64>, Vec<f64>, f64)> {
-        let cols: Vec<Vec<f64>> = terms.iter().map(|t| t.column(m)).collect();
+        let cols: Vec<std::borrow::Cow<'_, [f64]>> = terms.iter().map(|t| t.column(m)).collect();
         let target: Vec<f64> = self.data.output.iter().zip(m).map(|(y, m)| y - m).collect();
-        let refs: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
+        let refs: Vec<&[f64]> = cols.iter().map(|c| &**c).collect();
         let (beta, mse) = self.lsq(&refs, &target, &self.train)?;
         let mut pred = m.to_vec();
         for (c, b) in cols.iter().zip(&beta) {
-            for (p, v) in pred.iter_mut().zip(c) {
+            for (p, v) in pred.iter_mut().zip(c.iter()) {
                 *p += b * v;
             }
         }
@@ -373,7 +374,7 @@ impl Problem<'_> {
         theta: &[f64],
         iterations: usize,
     ) -> Option<(Fitted, f64)> {
-        let aug = AugSim { prob: self, transforms, terms, tune, cache: std::sync::Mutex::new(None) };
+        let aug = AugSim { prob: self, transforms, terms, tune, cache: std::sync::Mutex::new(Vec::new()) };
         let mut spec = self.spec.clone();
         let mut start = theta.to_vec();
         if let Some(t) = tune {
@@ -391,7 +392,9 @@ impl Problem<'_> {
         let p = if iterations == 0 {
             start
         } else {
-            let kin = self.kin(&[])?;
+            // AugSim makes its own kinematics (through the transforms): the objective's are
+            // read only for their length.
+            let kin = vec![model_core::Kin::default(); self.data.len()];
             let scale = {
                 let ys: Vec<f64> = self.train.iter().filter_map(|&i| self.data.output.get(i).copied()).collect();
                 let m = ys.iter().sum::<f64>() / ys.len().max(1) as f64;
@@ -399,7 +402,7 @@ impl Problem<'_> {
             };
             let obj =
                 crate::ident::fit::objective::Objective::new(&aug, &spec, &kin, &self.data.output, &self.train, scale);
-            let r = crate::ident::fit::lm::minimize(&obj, &start, iterations);
+            let r = crate::ident::fit::lm::minimize_reduced(&obj, &start, iterations);
             if r.cost.is_finite() && r.cost <= obj.cost(&start) {
                 r.params
             } else {
@@ -417,8 +420,8 @@ impl Problem<'_> {
     /// run of the base model, for scanning a candidate's grid cheaply.
     pub fn scan_cost(&self, transforms: &[Transform], terms: &[Term], theta: &[f64], jac: &[Vec<f64>]) -> Option<f64> {
         let m = self.run(theta, transforms)?;
-        let term_cols: Vec<Vec<f64>> = terms.iter().map(|t| t.column(&m)).collect();
-        let cols: Vec<&[f64]> = jac.iter().chain(&term_cols).map(Vec::as_slice).collect();
+        let term_cols: Vec<std::borrow::Cow<'_, [f64]>> = terms.iter().map(|t| t.column(&m)).collect();
+        let cols: Vec<&[f64]> = jac.iter().map(Vec::as_slice).chain(term_cols.iter().map(|c| &**c)).collect();
         let target: Vec<f64> = self.data.output.iter().zip(&m).map(|(y, m)| y - m).collect();
         self.lsq(&cols, &target, &self.train).map(|(_, mse)| mse)
     }

@@ -96,20 +96,42 @@ fn centred(v: &[f64]) -> Vec<f64> {
 }
 
 /// The local excitation frequency relative to its mean, less 1: `f_loc/f̄ − 1`, with
-/// `2π·f_loc` the RMS rate over the RMS level about the local mean, each smoothed without
-/// delay (forward and backward first-order low-pass, 0.25 s). 0 where the input rests.
-fn local_frequency(x: &[f64], dx: &[f64], dt: f64) -> Vec<f64> {
-    const SMOOTH_S: f64 = 0.25;
-    let zero_phase = |v: &[f64]| crate::numerics::derivative::filtfilt(v, SMOOTH_S / dt);
-    let level = zero_phase(x);
+/// `2π·f_loc` the RMS rate over the RMS level about the local mean, each a causal
+/// first-order average over `window_s` (the fluid's damping can follow the excitation only
+/// from what it has seen). 0 where the input rests.
+fn local_frequency(x: &[f64], dx: &[f64], dt: f64, window_s: f64) -> Vec<f64> {
+    let average = |v: &[f64]| lowpass(v, window_s, dt);
+    let level = average(x);
     let dev: Vec<f64> = x.iter().zip(&level).map(|(x, m)| (x - m) * (x - m)).collect();
-    let (p_x, p_dx) = (zero_phase(&dev), zero_phase(&dx.iter().map(|d| d * d).collect::<Vec<f64>>()));
+    let (p_x, p_dx) = (average(&dev), average(&dx.iter().map(|d| d * d).collect::<Vec<f64>>()));
     let f: Vec<f64> = p_x.iter().zip(&p_dx).map(|(px, pd)| if *px > 0.0 { (pd / px).sqrt() } else { 0.0 }).collect();
     let mean_f = mean(&f);
     if !(mean_f > 0.0 && mean_f.is_finite()) {
         return vec![0.0; x.len()];
     }
     f.iter().map(|v| if v.is_finite() { v / mean_f - 1.0 } else { 0.0 }).collect()
+}
+
+/// Averaging times (s) of the local excitation frequency a frequency-dependent damping is
+/// tried with: from a tenth of a second to a few seconds (log grid, refined by the refit).
+const FREQUENCY_WINDOWS_S: (f64, f64, usize) = (0.1, 3.0, 8);
+
+/// The damping that grows with the local excitation frequency, `c·(f_loc/f̄ − 1)·ẋ`, its
+/// averaging time the grid value.
+fn frequency_damping(s: &InputStats) -> Candidate {
+    let (x, dx, dt) = (s.x.clone(), s.dx.clone(), s.dt);
+    let (lo, hi, n) = FREQUENCY_WINDOWS_S;
+    Candidate {
+        effect: "rate_dependence",
+        label: "damping growing with the excitation frequency".into(),
+        grid_name: Some("window_s".into()),
+        grid: log_grid(lo, hi, n),
+        build: Box::new(move |w| {
+            let term = local_frequency(&x, &dx, dt, w).iter().zip(&dx).map(|(f, d)| f * d).collect();
+            Piece { transform: None, terms: vec![Term::additive("c_freq", term)] }
+        }),
+        channel: None,
+    }
 }
 
 /// A causal first-order low-pass with time constant `tau_s` (0: unchanged).
@@ -363,7 +385,6 @@ fn transform(
 fn kinematic_terms(s: &InputStats, aux: &[AuxChannel]) -> Vec<Candidate> {
     let rate_term: Vec<f64> = s.dx.iter().map(|v| v.abs() * v).collect();
     let cubed: Vec<f64> = s.dx.iter().map(|v| v * v * v).collect();
-    let by_frequency: Vec<f64> = local_frequency(&s.x, &s.dx, s.dt).iter().zip(&s.dx).map(|(f, d)| f * d).collect();
     let direction: Vec<f64> = s.dx.iter().map(|d| (d / (0.05 * s.dx_std)).tanh()).collect();
     let asym: Vec<f64> = s.x.iter().zip(&direction).map(|(x, d)| (x - s.x_mean) * d).collect();
     let asym2: Vec<f64> = s.x.iter().zip(&direction).map(|(x, d)| (x - s.x_mean).powi(2) * d).collect();
@@ -377,13 +398,7 @@ fn kinematic_terms(s: &InputStats, aux: &[AuxChannel]) -> Vec<Candidate> {
     vec![
         additive("rate_dependence", "term in |rate|·rate".into(), "c_rate", rate_term, None),
         additive("rate_dependence", "term in rate³".into(), "c_rate3", cubed, None),
-        additive(
-            "rate_dependence",
-            "damping growing with the excitation frequency".into(),
-            "c_freq",
-            by_frequency,
-            None,
-        ),
+        frequency_damping(s),
         additive("asymmetry", "loading/unloading difference growing with the input".into(), "delta", asym, None),
         additive(
             "asymmetry",

@@ -198,8 +198,9 @@ fn what(d: &Described<'_>) -> String {
             with_unit(coef, &yu)
         ),
         "rate_dependence" if c.label.contains("frequency") => format!(
-            "the damping grows with the excitation frequency beyond the model's linear rate term (c·(f/f̄ − 1)·rate, c = {} per ({xu}/s))",
-            with_unit(coef, &yu)
+            "the damping grows with the excitation frequency beyond the model's linear rate term (c·(f/f̄ − 1)·rate, c = {} per ({xu}/s), the frequency f averaged over the last {:.2} s)",
+            with_unit(coef, &yu),
+            g
         ),
         "rate_dependence" => format!(
             "the loop changes with the excitation rate beyond the model's linear rate term (a |rate|·rate term, coefficient {} per ({xu}/s)²)",

@@ -399,6 +399,43 @@ mod tests {
     }
 
     #[test]
+    fn a_damping_that_follows_the_excitation_frequency_is_named_with_its_window() {
+        // 30 s of blocks of 1.5 s at 2–6 Hz (phase-continuous), the amplitude (eased in over 50 ms)
+        // falling as 1/f so that the rate's amplitude is the same in every block: a term in
+        // the rate alone cannot follow the frequency. The clutch's extra damping follows the
+        // block's frequency through a 0.4 s first-order memory (known from the design, not
+        // estimated), c·(f_mem/f̄ − 1)·ḃ, sized to 4 % of the torque span (RMS).
+        let dt = 1e-3;
+        let freqs = [2.0, 4.5, 3.0, 6.0, 2.5, 5.0];
+        let f_of = |i: usize| freqs[(i as f64 * dt / 1.5) as usize % freqs.len()];
+        let (mut phase, mut memory, mut amp) = (0.0f64, f_of(0), 3.0 / f_of(0));
+        let (a, ease) = ((-dt / 0.4f64).exp(), (-dt / 0.05f64).exp());
+        let mut x = Vec::new();
+        let mut f_mem = Vec::new();
+        for i in 0..30_000 {
+            phase += std::f64::consts::TAU * f_of(i) * dt;
+            memory = a * memory + (1.0 - a) * f_of(i);
+            amp = ease * amp + (1.0 - ease) * 3.0 / f_of(i);
+            x.push(amp * (phase.sin() + 0.1 * (3.1 * phase).sin()));
+            f_mem.push(memory);
+        }
+        let db = crate::numerics::derivative::gradient(&x, dt);
+        let f_bar = crate::numerics::stats::mean(&f_mem);
+        let term: Vec<f64> = f_mem.iter().zip(&db).map(|(f, d)| (f / f_bar - 1.0) * d).collect();
+        let m = bouc_wen_truth(&x, dt);
+        let (lo, hi) = crate::numerics::stats::min_max(&m);
+        let k = 0.04 * (hi - lo) / (term.iter().map(|v| v * v).sum::<f64>() / term.len() as f64).sqrt();
+        let y: Vec<f64> = m.iter().zip(&term).map(|(m, t)| m + k * t).collect();
+        let d = run(&with_noise(x, &y, &mut rand::rngs::StdRng::seed_from_u64(11)));
+        let top = d.findings.first().unwrap_or_else(|| panic!("no finding: {:#?}", d.candidates));
+        assert_eq!(top.effect, "rate_dependence", "{:#?}", d.candidates);
+        assert!(top.evidence.label.contains("frequency"), "{}", top.evidence.label);
+        let w = top.params.get("window_s").copied().expect("its averaging time");
+        assert!((0.1..=3.0).contains(&w), "window {w} s");
+        assert!(top.summary.contains(" s)"), "{}", top.summary);
+    }
+
+    #[test]
     fn nothing_missing_gives_no_finding() {
         let d = run(&recording(None, 2));
         assert!(d.findings.is_empty(), "{:#?}", d.findings);

@@ -72,6 +72,9 @@ pub enum Set {
     /// An eighth held-out range, first run for the fourth report of 2026-11-27 (the rate
     /// smoothed at the input's content).
     Fresh7,
+    /// A ninth held-out range, first run for the report of 2026-11-27 (a frequency-dependent
+    /// damping averaged causally over a fitted time; the refits' least squares vectorised).
+    Fresh8,
 }
 
 impl Set {
@@ -86,6 +89,7 @@ impl Set {
         ("fresh5", Set::Fresh5),
         ("fresh6", Set::Fresh6),
         ("fresh7", Set::Fresh7),
+        ("fresh8", Set::Fresh8),
     ];
 
     /// The seed of case `k` of this set.
@@ -100,6 +104,7 @@ impl Set {
             Set::Fresh5 => 21_500_000 + 23 * k,
             Set::Fresh6 => 25_300_000 + 29 * k,
             Set::Fresh7 => 29_900_000 + 31 * k,
+            Set::Fresh8 => 34_000_000 + 37 * k,
         }
     }
 }
