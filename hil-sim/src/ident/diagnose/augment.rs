@@ -328,10 +328,17 @@ impl Problem<'_> {
                 (v.into_iter().map(|x| x / s).collect(), s)
             })
             .collect();
+        // The normal equations from column products (vectorised), one per pair.
         let k = scaled.len();
-        let g = nalgebra::DMatrix::<f64>::from_fn(k, k, |a, b| {
-            dot(&scaled[a].0, &scaled[b].0) + if a == b { 1e-10 } else { 0.0 }
-        });
+        let mut g = nalgebra::DMatrix::<f64>::zeros(k, k);
+        for a in 0..k {
+            for b in a..k {
+                let v = dot(&scaled[a].0, &scaled[b].0);
+                g[(a, b)] = v;
+                g[(b, a)] = v;
+            }
+            g[(a, a)] += 1e-10;
+        }
         let b = nalgebra::DVector::<f64>::from_fn(k, |a, _| dot(&scaled[a].0, &t));
         let sol = lstsq::solve_cholesky(g, &b, 1e-12)?;
         let coef: Vec<f64> = sol.iter().zip(&scaled).map(|(v, (_, s))| v / s).collect();
@@ -364,7 +371,8 @@ impl Problem<'_> {
 
     /// Refit θ, β and the candidate's value of the model `transforms` + `terms` (+ what
     /// `tune` builds), from `theta` (and `tune.start`), by the fit's bounded
-    /// Levenberg–Marquardt with at most `iterations` Jacobians. Returns the fit and the
+    /// Levenberg–Marquardt on its reduced step ([`crate::numerics::reduce`]: tens of
+    /// thousands of rows, a handful of parameters) with at most `iterations` Jacobians. Returns the fit and the
     /// candidate's final value (0 without one); `None` when the start diverges.
     pub fn refit(
         &self,
