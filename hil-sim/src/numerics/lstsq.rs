@@ -1,9 +1,42 @@
 //! Linear least squares on the normal equations of small problems (a few dozen columns at
-//! most): accumulate `AᵀA`, `Aᵀb` row by row without an m×n matrix, then solve by SVD with a
+//! most): accumulate `AᵀA`, `Aᵀb` row by row without an m×n matrix (or, for columns already
+//! in memory, from their products: [`gram`]), then solve by SVD with a
 //! relative cut-off (a column the data does not excite gets a zero coefficient instead of a
 //! blow-up), or by Cholesky with a ridge. The sign-constrained variant is [`super::nnls`].
 
 use nalgebra::{DMatrix, DVector};
+
+/// `Σ aᵢ·bᵢ` in eight independent partial sums (vectorised, and the same on every machine:
+/// the order of the additions is fixed).
+pub fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    let mut acc = [0.0f64; 8];
+    for (x, y) in ca.zip(cb) {
+        for k in 0..8 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    let mut s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+    for (x, y) in ra.iter().zip(rb) {
+        s += x * y;
+    }
+    s
+}
+
+/// `AᵀA` of the columns `cols` (equal lengths) by their products ([`dot`]), each pair once.
+pub fn gram(cols: &[&[f64]]) -> DMatrix<f64> {
+    let k = cols.len();
+    let mut g = DMatrix::<f64>::zeros(k, k);
+    for a in 0..k {
+        for b in a..k {
+            let v = dot(cols[a], cols[b]);
+            g[(a, b)] = v;
+            g[(b, a)] = v;
+        }
+    }
+    g
+}
 
 /// Add one row `a` with target `b` to the lower triangle of `gram` and to `atb`.
 pub fn accumulate(gram: &mut DMatrix<f64>, atb: &mut DVector<f64>, a: &[f64], b: f64) {

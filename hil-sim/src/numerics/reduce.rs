@@ -21,18 +21,10 @@ const DEPENDENT: f64 = 1e-13;
 /// and `A`'s first row `rᵀJ / ‖r‖` (so `Aᵀ(‖r‖·e₁) = Jᵀr`); rows of `A` below a dependent
 /// pivot are zero.
 pub fn reduced(j: &DMatrix<f64>, r: &[f64]) -> DMatrix<f64> {
-    let n = j.ncols();
-    let mut m = DMatrix::<f64>::zeros(j.nrows(), n + 1);
-    m.column_mut(0).copy_from_slice(r);
-    m.columns_mut(1, n).copy_from(j);
-    let mut g = DMatrix::<f64>::zeros(n + 1, n + 1);
-    for a in 0..=n {
-        for b in a..=n {
-            let v = dot(m.column(a).as_slice(), m.column(b).as_slice());
-            g[(a, b)] = v;
-            g[(b, a)] = v;
-        }
-    }
+    let (rows, n) = j.shape();
+    // `[r J]`'s columns (J is stored column by column).
+    let cols: Vec<&[f64]> = std::iter::once(r).chain((0..n).map(|c| &j.as_slice()[c * rows..(c + 1) * rows])).collect();
+    let g = super::lstsq::gram(&cols);
     let mut u = DMatrix::<f64>::zeros(n + 1, n + 1);
     for k in 0..=n {
         let d = g[(k, k)] - (0..k).map(|i| u[(i, k)] * u[(i, k)]).sum::<f64>();
@@ -48,24 +40,6 @@ pub fn reduced(j: &DMatrix<f64>, r: &[f64]) -> DMatrix<f64> {
         }
     }
     u.columns(1, n).into_owned()
-}
-
-/// `Σ aᵢ·bᵢ` in eight independent partial sums (vectorised, and the same on every machine:
-/// the order of the additions is fixed).
-pub fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
-    let (ra, rb) = (ca.remainder(), cb.remainder());
-    let mut acc = [0.0f64; 8];
-    for (x, y) in ca.zip(cb) {
-        for k in 0..8 {
-            acc[k] += x[k] * y[k];
-        }
-    }
-    let mut s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
-    for (x, y) in ra.iter().zip(rb) {
-        s += x * y;
-    }
-    s
 }
 
 /// The residual vector that goes with [`reduced`]: `‖r‖·e₁` (`n + 1` entries).

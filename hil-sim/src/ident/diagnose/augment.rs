@@ -23,8 +23,7 @@ use crate::ident::fit::simulate::{kinematics, Simulator};
 use crate::ident::fit::Dataset;
 use crate::models::search::{ModelSpec, Spacing};
 use crate::models::RateSpec;
-use crate::numerics::lstsq;
-use crate::numerics::reduce::dot;
+use crate::numerics::lstsq::{self, dot};
 
 /// A change to what the base model is fed.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -328,18 +327,13 @@ impl Problem<'_> {
                 (v.into_iter().map(|x| x / s).collect(), s)
             })
             .collect();
-        // The normal equations from column products (vectorised), one per pair.
-        let k = scaled.len();
-        let mut g = nalgebra::DMatrix::<f64>::zeros(k, k);
-        for a in 0..k {
-            for b in a..k {
-                let v = dot(&scaled[a].0, &scaled[b].0);
-                g[(a, b)] = v;
-                g[(b, a)] = v;
-            }
+        // The normal equations from column products (vectorised), with the ridge.
+        let cols: Vec<&[f64]> = scaled.iter().map(|(c, _)| c.as_slice()).collect();
+        let mut g = lstsq::gram(&cols);
+        for a in 0..cols.len() {
             g[(a, a)] += 1e-10;
         }
-        let b = nalgebra::DVector::<f64>::from_fn(k, |a, _| dot(&scaled[a].0, &t));
+        let b = nalgebra::DVector::<f64>::from_fn(cols.len(), |a, _| dot(cols[a], &t));
         let sol = lstsq::solve_cholesky(g, &b, 1e-12)?;
         let coef: Vec<f64> = sol.iter().zip(&scaled).map(|(v, (_, s))| v / s).collect();
         if coef.iter().any(|v| !v.is_finite()) {

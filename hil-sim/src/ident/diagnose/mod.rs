@@ -424,7 +424,7 @@ mod tests {
         let term: Vec<f64> = f_mem.iter().zip(&db).map(|(f, d)| (f / f_bar - 1.0) * d).collect();
         let m = bouc_wen_truth(&x, dt);
         let (lo, hi) = crate::numerics::stats::min_max(&m);
-        let k = 0.04 * (hi - lo) / (term.iter().map(|v| v * v).sum::<f64>() / term.len() as f64).sqrt();
+        let k = 0.04 * (hi - lo) / crate::numerics::stats::rms(&term);
         let y: Vec<f64> = m.iter().zip(&term).map(|(m, t)| m + k * t).collect();
         let d = run(&with_noise(x, &y, &mut rand::rngs::StdRng::seed_from_u64(11)));
         let top = d.findings.first().unwrap_or_else(|| panic!("no finding: {:#?}", d.candidates));
