@@ -141,15 +141,30 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
                 format!("{:.1}", c.bic_gain),
                 format!("{:.2} → {:.2}", 100.0 * c.heldout_r_rmse_before, 100.0 * c.heldout_r_rmse_after),
                 format!("{:.1}", c.test.t),
+                c.replication
+                    .map(|r| {
+                        format!(
+                            "head {:.0} % lower; both p = {:.4}{}",
+                            100.0 * r.head.gain,
+                            r.both.p_rank,
+                            if r.passed { " (passed)" } else { "" }
+                        )
+                    })
+                    .unwrap_or_default(),
                 if c.kept { "kept".into() } else { String::new() },
             ]
         })
         .collect();
     rep.paragraph(
         "Every candidate tested, by round, by BIC gain (kept: of those that pass the held-out block test, the one with \
-         the lowest held-out error):",
+         the lowest held-out error). Reversed split: a candidate the held-out tail left undecided, or close to another \
+         effect's, refitted with the first part of the recording held out instead; its gain there and the signed-rank p \
+         over the blocks of both held-out parts:",
     );
-    rep.table(&["round", "effect", "term", "BIC gain", "held-out R-RMSE (%)", "t-statistic", ""], &tested);
+    rep.table(
+        &["round", "effect", "term", "BIC gain", "held-out R-RMSE (%)", "t-statistic", "reversed split", ""],
+        &tested,
+    );
 }
 
 /// A finding's value with its unit: from the finding's `units`, else from the name's suffix.

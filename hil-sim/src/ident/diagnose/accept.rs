@@ -3,12 +3,14 @@
 //! block test ([`super::significance`]) with a gain of at least
 //! [`significance::MIN_FINDING_GAIN`], changes the prediction by more than the
 //! residual's noise floor resolves and is physically possible ([`super::physical`]) is
-//! kept; every candidate is recorded as tested.
+//! kept; every candidate is recorded as tested. One that meets all of it but the block
+//! test, and would predict the tail best, is given the reversed split ([`super::replicate`]).
 
-use super::augment::Fitted;
+use super::augment::{Fitted, Problem};
 use super::candidates::Candidate;
 use super::diagnosis::Tested;
 use super::rank::Scored;
+use super::replicate::{self, Replication, Reversed};
 use super::significance::{self, Test};
 use crate::numerics::metrics::{metrics, Metrics};
 
@@ -28,6 +30,8 @@ pub struct Accepted {
     pub scored: Scored,
     pub test: Test,
     pub after: Metrics,
+    /// The reversed split, when the tail alone did not settle it.
+    pub replication: Option<Replication>,
 }
 
 /// A round's outcome: every candidate as tested and the one kept, if any.
@@ -45,14 +49,26 @@ impl Judge<'_> {
         metrics(&pick(self.y), &pick(pred), None)
     }
 
-    /// Judge the `ranked` candidates of round `round` (1-based) against `reference`: of the
+    /// Judge the `ranked` candidates of round `round` (1-based) of `prob` against `reference`: of the
     /// eligible ones (a training gain, significant on the held-out blocks, resolvable above
     /// the noise, physically possible), the one with the lowest held-out error is kept — the
     /// term that predicts data it was not fitted on best, not the one that fits the
     /// training part best (a wrong term on a misfitting base can fit more and predict less).
-    pub fn round(&self, round: usize, cands: &[Candidate], reference: &Fitted, ranked: Vec<Scored>) -> Verdict {
+    /// The candidates that would predict better still but miss only the block test get the
+    /// reversed split, best first ([`replicate`]), and so do the best and another effect's
+    /// eligible candidates within [`replicate::NEAR`] of its held-out error: of those, the one
+    /// that predicts both held-out parts best is kept.
+    pub fn round(
+        &self,
+        round: usize,
+        prob: &Problem<'_>,
+        cands: &[Candidate],
+        reference: &Fitted,
+        ranked: Vec<Scored>,
+    ) -> Verdict {
         let before = self.heldout(&reference.pred);
         let mut tested = Vec::with_capacity(ranked.len());
+        // Per candidate: every condition but the block test met, the block test passed.
         let mut judged = Vec::with_capacity(ranked.len());
         for s in ranked {
             let (c, f) = (&cands[s.index], &s.fitted);
@@ -65,10 +81,9 @@ impl Judge<'_> {
             let change_of_noise = change / self.noise_rms.max(1e-300);
             let resolvable = change_of_noise >= significance::MIN_TERM_OF_NOISE;
             let impossible = super::physical::impossible(c, f, reference.terms.len(), s.value, self.dt);
-            let eligible = impossible.is_none()
+            let otherwise = impossible.is_none()
                 && s.bic_gain > 0.0
                 && f.train_mse < reference.train_mse
-                && test.significant
                 && test.gain >= significance::MIN_FINDING_GAIN
                 && resolvable;
             tested.push(Tested {
@@ -83,16 +98,88 @@ impl Judge<'_> {
                 change_of_noise,
                 kept: false,
                 impossible,
+                replication: None,
             });
-            judged.push((eligible, s, test, after));
+            judged.push(Judged { otherwise, significant: test.significant, scored: s, test, after });
         }
-        let best =
-            (0..judged.len()).filter(|&k| judged[k].0).min_by(|&a, &b| judged[a].3.rmse.total_cmp(&judged[b].3.rmse));
+        let reversed = Reversed::new(prob, reference);
+        let replicate = |k: usize| {
+            let s = &judged[k].scored;
+            let tail = significance::blocks(self.y, &reference.pred, &s.fitted.pred, self.held);
+            reversed.replicate(&cands[s.index], s, &tail)
+        };
+        let effect = |k: usize| cands[judged[k].scored.index].effect;
+        let best = choose(&judged, &mut tested, replicate, effect);
         let accepted = best.map(|k| {
             tested[k].kept = true;
-            let (_, s, test, after) = judged.swap_remove(k);
-            Accepted { scored: s, test, after }
+            let replication = tested[k].replication;
+            let Judged { scored, test, after, .. } = judged.swap_remove(k);
+            Accepted { scored, test, after, replication }
         });
         Verdict { before, tested, accepted }
     }
+}
+
+/// A candidate as judged: every condition but the block test met (`otherwise`), the block
+/// test passed, its score, test and held-out metrics.
+struct Judged {
+    otherwise: bool,
+    significant: bool,
+    scored: Scored,
+    test: Test,
+    after: Metrics,
+}
+
+/// The index of the candidate kept, if any: of the eligible ones and the best undecided one
+/// that passes on the reversed split (`replicate`, recorded in `tested`), the lowest held-out
+/// error; when other effects' eligible candidates (`effect`) come within
+/// [`replicate::NEAR`] of it, the one of them all with the best pooled gain.
+fn choose(
+    judged: &[Judged],
+    tested: &mut [Tested],
+    replicate: impl Fn(usize) -> Option<Replication>,
+    effect: impl Fn(usize) -> &'static str,
+) -> Option<usize> {
+    let by_error = |a: &usize, b: &usize| judged[*a].after.rmse.total_cmp(&judged[*b].after.rmse);
+    let mut eligible: Vec<usize> =
+        (0..judged.len()).filter(|&k| judged[k].otherwise && judged[k].significant).collect();
+    let bar = eligible.iter().min_by(|a, b| by_error(a, b)).map_or(f64::INFINITY, |&k| judged[k].after.rmse);
+    let mut undecided: Vec<usize> = (0..judged.len())
+        .filter(|&k| judged[k].otherwise && !judged[k].significant && judged[k].after.rmse < bar)
+        .collect();
+    undecided.sort_by(by_error);
+    for k in undecided.into_iter().take(replicate::MAX_TRIED) {
+        tested[k].replication = replicate(k);
+        if tested[k].replication.is_some_and(|r| r.passed) {
+            eligible.push(k);
+            break;
+        }
+    }
+    let best = eligible.iter().copied().min_by(by_error)?;
+    // Another effect's eligible term within `NEAR` of the best on the tail: the tail alone
+    // cannot tell them apart, and both splits together decide.
+    let near: Vec<usize> = eligible
+        .iter()
+        .copied()
+        .filter(|&k| {
+            k != best
+                && effect(k) != effect(best)
+                && judged[k].after.rmse <= (1.0 + replicate::NEAR) * judged[best].after.rmse
+        })
+        .collect();
+    if near.is_empty() {
+        return Some(best);
+    }
+    for &k in near.iter().chain([&best]) {
+        if tested[k].replication.is_none() {
+            tested[k].replication = replicate(k);
+        }
+    }
+    let pooled = |k: usize| tested[k].replication.map(|r| r.both.gain);
+    let winner = near
+        .iter()
+        .copied()
+        .filter(|&k| pooled(k) > pooled(best))
+        .max_by(|&x, &y| pooled(x).unwrap_or(f64::MIN).total_cmp(&pooled(y).unwrap_or(f64::MIN)));
+    Some(winner.unwrap_or(best))
 }

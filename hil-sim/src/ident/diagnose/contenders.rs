@@ -109,8 +109,8 @@ pub fn open<'a>(base: &'a Base, s: &Shared<'a, '_>, with_plays: bool) -> Result<
         level = Some(p);
     }
     let reference = rank::reference(&prob, &current).ok_or_else(diverges)?;
-    let first = rank::rank(&prob, s.cands, &reference, &[]).map(|ranked| {
-        let verdict = judge.round(1, s.cands, &reference, ranked);
+    let first = rank::rank(&prob, s.cands, &reference, &[]).map(|(reference, ranked)| {
+        let verdict = judge.round(1, &prob, s.cands, &reference, ranked);
         (reference, verdict)
     });
     Ok(Opening { base, plays: with_plays, before, prob, current, level, located, first })

@@ -10,6 +10,7 @@ use super::augment::Fitted;
 use super::candidates::Candidate;
 use super::diagnosis::{Evidence, Finding, Tested};
 use super::locate::{self, Condition};
+use super::replicate::Replication;
 use super::significance::Test;
 use crate::ident::fit::Dataset;
 use crate::numerics::metrics::Metrics;
@@ -29,6 +30,8 @@ pub struct Described<'a> {
     pub before: Metrics,
     pub after: Metrics,
     pub test: Test,
+    /// The reversed split, when the tail alone did not settle it.
+    pub replication: Option<Replication>,
     pub bic_gain: f64,
     /// Span (peak to peak) of the output on the held-out rows.
     pub y_span: f64,
@@ -120,8 +123,18 @@ pub fn finding(d: &Described<'_>) -> Finding {
     );
     let weak =
         d.runner_up.as_ref().map(|r| format!("; the evidence is weak: the runner-up is {r}")).unwrap_or_default();
+    let again = d
+        .replication
+        .map(|r| {
+            format!(
+                " (the held-out tail alone did not settle it; refitted with the head held out instead, the head's error \
+                 is {:.0} % lower too)",
+                100.0 * r.head.gain
+            )
+        })
+        .unwrap_or_default();
     let summary = format!(
-        "{}; {size}; held-out R-RMSE {:.2} % -> {:.2} % ({:.0} % lower){weak}{}",
+        "{}; {size}; held-out R-RMSE {:.2} % -> {:.2} % ({:.0} % lower){again}{weak}{}",
         what(d),
         100.0 * d.before.r_rmse,
         100.0 * d.after.r_rmse,
@@ -141,6 +154,7 @@ pub fn finding(d: &Described<'_>) -> Finding {
             label: c.label.clone(),
             channel: c.channel.clone(),
             test: d.test,
+            replication: d.replication,
             term_rms,
             term_share_of_span: share,
             bic_gain: d.bic_gain,

@@ -8,6 +8,7 @@ use serde::Serialize;
 
 use super::candidates::AuxChannel;
 use super::locate::{Condition, Locate};
+use super::replicate::Replication;
 use super::significance::Test;
 use crate::numerics::metrics::Metrics;
 
@@ -41,6 +42,9 @@ pub struct Evidence {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub channel: Option<String>,
     pub test: Test,
+    /// The reversed split, when the held-out tail alone did not settle it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub replication: Option<Replication>,
     /// RMS of what the term changes in the prediction, output units, and as a share of the
     /// output's span.
     pub term_rms: f64,
@@ -69,6 +73,9 @@ pub struct Tested {
     /// Why its fitted values are physically impossible (then it is never kept).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub impossible: Option<String>,
+    /// The reversed split, when it was given one ([`super::replicate`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub replication: Option<Replication>,
 }
 
 /// The whole diagnosis.

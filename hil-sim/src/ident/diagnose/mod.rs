@@ -21,10 +21,11 @@
 //!    input transform's grid profiled by short refits instead), then the term refitted
 //!    jointly with the base parameters ([`augment`]). Candidates are ranked by the
 //!    Bayesian information criterion on the training part.
-//! 4. **Model** ([`accept`]). In that order, the first candidate whose held-out gain passes
-//!    the paired block test ([`significance`]) is kept, and the search repeats on what
-//!    remains (at most `max_findings` rounds). A recording with nothing missing ends with
-//!    no finding.
+//! 4. **Model** ([`accept`]). Of the candidates whose held-out gain passes the paired block
+//!    test ([`significance`]), the one that predicts the held-out part best is kept; one the
+//!    tail alone leaves undecided, or two effects the tail cannot tell apart, are refitted on
+//!    the reversed split ([`replicate`]). The search repeats on what remains (at most
+//!    `max_findings` rounds). A recording with nothing missing ends with no finding.
 //! 5. **Report** ([`describe`], [`crate::report::diagnose`]). Each finding says which physics, how big (its
 //!    fitted values with units and the RMS of what it adds), where (windows and conditions
 //!    where the gain concentrates) and the held-out error before and after; [`crate::report::diagnose`]
@@ -46,6 +47,7 @@ pub mod physical;
 pub mod profile;
 pub mod rank;
 pub mod refit;
+pub mod replicate;
 pub mod scan;
 pub mod significance;
 
@@ -157,8 +159,8 @@ fn diagnose_at_rate(
             Some(f) => f,
             None => {
                 let reference = rank::reference(&prob, &current).ok_or_else(diverges)?;
-                rank::rank(&prob, &cands, &reference, &used).map(|ranked| {
-                    let verdict = judge.round(round + 1, &cands, &reference, ranked);
+                rank::rank(&prob, &cands, &reference, &used).map(|(reference, ranked)| {
+                    let verdict = judge.round(round + 1, &prob, &cands, &reference, ranked);
                     (reference, verdict)
                 })
             }
@@ -182,6 +184,7 @@ fn diagnose_at_rate(
             before: verdict.before,
             after: kept.after,
             test: kept.test,
+            replication: kept.replication,
             bic_gain: kept.scored.bic_gain,
             y_span,
             rate: &dx,
@@ -275,7 +278,7 @@ mod tests {
 
     /// A bouc_wen recording of a three-tone input; the model is fed the input through
     /// `effect` and the output gets white noise of 0.5 % of its span.
-    fn recording(effect: Option<Transform>, seed: u64) -> Dataset {
+    pub(super) fn recording(effect: Option<Transform>, seed: u64) -> Dataset {
         let tone = |t: f64, f: f64, ph: f64| (2.0 * std::f64::consts::PI * f * t + ph).sin();
         let x = |t: f64| tone(t, 2.0, 0.0) + 0.5 * tone(t, 7.3, 1.0) + 0.25 * tone(t, 13.1, 2.0);
         recording_with(x, effect, |_| 0.0, seed)

@@ -75,6 +75,9 @@ pub enum Set {
     /// A ninth held-out range, first run for the report of 2026-11-27 (a frequency-dependent
     /// damping averaged causally over a fitted time; the refits' least squares vectorised).
     Fresh8,
+    /// A tenth held-out range, first run for the report of 2026-11-27 (the reversed split for
+    /// a candidate the held-out tail leaves undecided).
+    Fresh9,
 }
 
 impl Set {
@@ -90,6 +93,7 @@ impl Set {
         ("fresh6", Set::Fresh6),
         ("fresh7", Set::Fresh7),
         ("fresh8", Set::Fresh8),
+        ("fresh9", Set::Fresh9),
     ];
 
     /// The seed of case `k` of this set.
@@ -105,6 +109,7 @@ impl Set {
             Set::Fresh6 => 25_300_000 + 29 * k,
             Set::Fresh7 => 29_900_000 + 31 * k,
             Set::Fresh8 => 34_000_000 + 37 * k,
+            Set::Fresh9 => 38_000_000 + 41 * k,
         }
     }
 }
