@@ -78,6 +78,9 @@ pub enum Set {
     /// A tenth held-out range, first run for the report of 2026-11-27 (the reversed split for
     /// a candidate the held-out tail leaves undecided).
     Fresh9,
+    /// An eleventh held-out range, first run for the same report as fresh9, with the same
+    /// method: the ranges differ by more than the change measured on one of them.
+    Fresh10,
 }
 
 impl Set {
@@ -94,6 +97,7 @@ impl Set {
         ("fresh7", Set::Fresh7),
         ("fresh8", Set::Fresh8),
         ("fresh9", Set::Fresh9),
+        ("fresh10", Set::Fresh10),
     ];
 
     /// The seed of case `k` of this set.
@@ -110,6 +114,7 @@ impl Set {
             Set::Fresh7 => 29_900_000 + 31 * k,
             Set::Fresh8 => 34_000_000 + 37 * k,
             Set::Fresh9 => 38_000_000 + 41 * k,
+            Set::Fresh10 => 46_000_000 + 43 * k,
         }
     }
 }
