@@ -143,10 +143,14 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
                 format!("{:.1}", c.test.t),
                 c.replication
                     .map(|r| {
+                        let p = if r.both.p_rank < 1e-4 {
+                            "< 0.0001".to_owned()
+                        } else {
+                            format!("= {:.4}", r.both.p_rank)
+                        };
                         format!(
-                            "head {:.0} % lower; both p = {:.4}{}",
+                            "head {:.0} % lower; both p {p}{}",
                             100.0 * r.head.gain,
-                            r.both.p_rank,
                             if r.passed { " (passed)" } else { "" }
                         )
                     })

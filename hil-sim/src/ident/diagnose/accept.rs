@@ -175,11 +175,14 @@ fn choose(
             tested[k].replication = replicate(k);
         }
     }
+    // Without the best one's own reversed split there is nothing to weigh a rival against.
     let pooled = |k: usize| tested[k].replication.map(|r| r.both.gain);
+    let Some(bar) = pooled(best) else { return Some(best) };
     let winner = near
         .iter()
-        .copied()
-        .filter(|&k| pooled(k) > pooled(best))
-        .max_by(|&x, &y| pooled(x).unwrap_or(f64::MIN).total_cmp(&pooled(y).unwrap_or(f64::MIN)));
+        .filter_map(|&k| pooled(k).map(|g| (k, g)))
+        .filter(|&(_, g)| g > bar)
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(k, _)| k);
     Some(winner.unwrap_or(best))
 }

@@ -126,10 +126,19 @@ pub fn finding(d: &Described<'_>) -> Finding {
     let again = d
         .replication
         .map(|r| {
+            let why = if d.test.significant {
+                format!(
+                    "another effect's term came within {:.0} % of it on the held-out tail",
+                    100.0 * super::replicate::NEAR
+                )
+            } else {
+                "the held-out tail alone did not settle it".to_owned()
+            };
             format!(
-                " (the held-out tail alone did not settle it; refitted with the head held out instead, the head's error \
-                 is {:.0} % lower too)",
-                100.0 * r.head.gain
+                " ({why}; refitted with the head held out instead, the head's error is {:.0} % lower, {:.0} % over both \
+                 held-out parts)",
+                100.0 * r.head.gain,
+                100.0 * r.both.gain
             )
         })
         .unwrap_or_default();
