@@ -1,7 +1,8 @@
 //! Stage 4 of a diagnosis, modelling: in the round's ranking, the first candidate that
 //! lowers the training error, gains on the information criterion, passes the held-out
 //! block test ([`super::significance`]) with a gain of at least
-//! [`significance::MIN_FINDING_GAIN`], changes the prediction by more than the
+//! [`significance::MIN_FINDING_GAIN`] (and [`significance::MIN_FINDING_DROP`] of the output),
+//! changes the prediction by more than the
 //! residual's noise floor resolves and is physically possible ([`super::physical`]) is
 //! kept; every candidate is recorded as tested. One that meets all of it but the block
 //! test, and would predict the tail best, is given the reversed split ([`super::replicate`]).
@@ -9,6 +10,7 @@
 use super::augment::{Fitted, Problem};
 use super::candidates::Candidate;
 use super::diagnosis::Tested;
+use super::lag_or_delay::{self, Mixture, Side};
 use super::rank::Scored;
 use super::replicate::{self, Replication, Reversed};
 use super::significance::{self, Test};
@@ -32,6 +34,8 @@ pub struct Accepted {
     pub after: Metrics,
     /// The reversed split, when the tail alone did not settle it.
     pub replication: Option<Replication>,
+    /// The field lag and the delay given together, when that settled a tie between them.
+    pub lag_or_delay: Option<Mixture>,
 }
 
 /// A round's outcome: every candidate as tested and the one kept, if any.
@@ -85,6 +89,7 @@ impl Judge<'_> {
                 && s.bic_gain > 0.0
                 && f.train_mse < reference.train_mse
                 && test.gain >= significance::MIN_FINDING_GAIN
+                && before.r_rmse - after.r_rmse >= significance::MIN_FINDING_DROP
                 && resolvable;
             tested.push(Tested {
                 round,
@@ -99,6 +104,7 @@ impl Judge<'_> {
                 kept: false,
                 impossible,
                 replication: None,
+                lag_or_delay: None,
             });
             judged.push(Judged { otherwise, significant: test.significant, scored: s, test, after });
         }
@@ -109,12 +115,16 @@ impl Judge<'_> {
             reversed.replicate(&cands[s.index], s, &tail)
         };
         let effect = |k: usize| cands[judged[k].scored.index].effect;
-        let best = choose(&judged, &mut tested, replicate, effect);
+        let mixture = |lag: usize, delay: usize| {
+            let (l, d) = (&judged[lag].scored, &judged[delay].scored);
+            lag_or_delay::profile(prob, reference, (&cands[l.index], l), (&cands[d.index], d))
+        };
+        let best = choose(&judged, &mut tested, Ties { replicate, mixture, effect });
         let accepted = best.map(|k| {
             tested[k].kept = true;
-            let replication = tested[k].replication;
+            let (replication, lag_or_delay) = (tested[k].replication, tested[k].lag_or_delay);
             let Judged { scored, test, after, .. } = judged.swap_remove(k);
-            Accepted { scored, test, after, replication }
+            Accepted { scored, test, after, replication, lag_or_delay }
         });
         Verdict { before, tested, accepted }
     }
@@ -130,16 +140,26 @@ struct Judged {
     after: Metrics,
 }
 
+/// How [`choose`] breaks what the tail leaves open, per judged candidate: its reversed split,
+/// the profile of a lag (first index) against a delay (second), its effect.
+struct Ties<R, M, E> {
+    replicate: R,
+    mixture: M,
+    effect: E,
+}
+
 /// The index of the candidate kept, if any: of the eligible ones and the best undecided one
 /// that passes on the reversed split (`replicate`, recorded in `tested`), the lowest held-out
 /// error; when other effects' eligible candidates (`effect`) come within
-/// [`replicate::NEAR`] of it, the one of them all with the best pooled gain.
-fn choose(
-    judged: &[Judged],
-    tested: &mut [Tested],
-    replicate: impl Fn(usize) -> Option<Replication>,
-    effect: impl Fn(usize) -> &'static str,
-) -> Option<usize> {
+/// [`replicate::NEAR`] of it, the one the lag and the delay given together name when the tie
+/// is between those two ([`lag_or_delay`]), else the one of them all with the best pooled gain.
+fn choose<R, M, E>(judged: &[Judged], tested: &mut [Tested], ties: Ties<R, M, E>) -> Option<usize>
+where
+    R: Fn(usize) -> Option<Replication>,
+    M: Fn(usize, usize) -> Option<Mixture>,
+    E: Fn(usize) -> &'static str,
+{
+    let Ties { replicate, mixture, effect } = ties;
     let by_error = |a: &usize, b: &usize| judged[*a].after.rmse.total_cmp(&judged[*b].after.rmse);
     let mut eligible: Vec<usize> =
         (0..judged.len()).filter(|&k| judged[k].otherwise && judged[k].significant).collect();
@@ -170,6 +190,9 @@ fn choose(
     if near.is_empty() {
         return Some(best);
     }
+    if let Some(k) = lag_against_delay(best, &near, judged, tested, mixture, &effect) {
+        return Some(k);
+    }
     for &k in near.iter().chain([&best]) {
         if tested[k].replication.is_none() {
             tested[k].replication = replicate(k);
@@ -185,4 +208,35 @@ fn choose(
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(k, _)| k);
     Some(winner.unwrap_or(best))
+}
+
+/// When the tie is a field lag against a delay of the torque and nothing else, the one the
+/// two given together name ([`lag_or_delay`]), the profile recorded on both; `None` when the
+/// tie is another or the profile does not say.
+fn lag_against_delay(
+    best: usize,
+    near: &[usize],
+    judged: &[Judged],
+    tested: &mut [Tested],
+    mixture: impl Fn(usize, usize) -> Option<Mixture>,
+    effect: impl Fn(usize) -> &'static str,
+) -> Option<usize> {
+    let all: Vec<usize> = near.iter().copied().chain([best]).collect();
+    if all.iter().any(|&k| !matches!(effect(k), "field_lag" | "transport_delay")) {
+        return None;
+    }
+    let first = |e: &str| {
+        all.iter()
+            .copied()
+            .filter(|&k| effect(k) == e)
+            .min_by(|a, b| judged[*a].after.rmse.total_cmp(&judged[*b].after.rmse))
+    };
+    let (lag, delay) = (first("field_lag")?, first("transport_delay")?);
+    let m = mixture(lag, delay)?;
+    tested[lag].lag_or_delay = Some(m);
+    tested[delay].lag_or_delay = Some(m);
+    match m.side()? {
+        Side::Lag => Some(lag),
+        Side::Delay => Some(delay),
+    }
 }

@@ -9,6 +9,7 @@ use std::collections::BTreeMap;
 use super::augment::Fitted;
 use super::candidates::Candidate;
 use super::diagnosis::{Evidence, Finding, Tested};
+use super::lag_or_delay::Mixture;
 use super::locate::{self, Condition};
 use super::replicate::Replication;
 use super::significance::Test;
@@ -32,6 +33,8 @@ pub struct Described<'a> {
     pub test: Test,
     /// The reversed split, when the tail alone did not settle it.
     pub replication: Option<Replication>,
+    /// The field lag and the delay given together, when that settled a tie between them.
+    pub lag_or_delay: Option<Mixture>,
     pub bic_gain: f64,
     /// Span (peak to peak) of the output on the held-out rows.
     pub y_span: f64,
@@ -142,8 +145,9 @@ pub fn finding(d: &Described<'_>) -> Finding {
             )
         })
         .unwrap_or_default();
+    let both = d.lag_or_delay.map(|m| mixture_clause(&m, c.effect)).unwrap_or_default();
     let summary = format!(
-        "{}; {size}; held-out R-RMSE {:.2} % -> {:.2} % ({:.0} % lower){again}{weak}{}",
+        "{}; {size}; held-out R-RMSE {:.2} % -> {:.2} % ({:.0} % lower){again}{both}{weak}{}",
         what(d),
         100.0 * d.before.r_rmse,
         100.0 * d.after.r_rmse,
@@ -164,12 +168,25 @@ pub fn finding(d: &Described<'_>) -> Finding {
             channel: c.channel.clone(),
             test: d.test,
             replication: d.replication,
+            lag_or_delay: d.lag_or_delay,
             term_rms,
             term_share_of_span: share,
             bic_gain: d.bic_gain,
         },
         runner_up: d.runner_up.clone(),
     }
+}
+
+/// How a tie between a field lag and a delay of the torque was settled, in words.
+fn mixture_clause(m: &Mixture, effect: &str) -> String {
+    let rival = if effect == "field_lag" { "a delay of the torque" } else { "a lag of the field" };
+    format!(
+        " (it came within {:.0} % of {rival} on the held-out tail; given both at once, the training error is least \
+         with {:.0} % of the {} delay)",
+        100.0 * super::replicate::NEAR,
+        100.0 * m.best_share,
+        with_unit(1e3 * m.delay_s, "ms")
+    )
 }
 
 /// Which physics, in words.

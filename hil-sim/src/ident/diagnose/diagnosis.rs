@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use serde::Serialize;
 
 use super::candidates::AuxChannel;
+use super::lag_or_delay::Mixture;
 use super::locate::{Condition, Locate};
 use super::replicate::Replication;
 use super::significance::Test;
@@ -45,6 +46,9 @@ pub struct Evidence {
     /// The reversed split, when the held-out tail alone did not settle it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub replication: Option<Replication>,
+    /// The lag and the delay given together, when that told them apart.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lag_or_delay: Option<Mixture>,
     /// RMS of what the term changes in the prediction, output units, and as a share of the
     /// output's span.
     pub term_rms: f64,
@@ -76,6 +80,10 @@ pub struct Tested {
     /// The reversed split, when it was given one ([`super::replicate`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub replication: Option<Replication>,
+    /// A field lag and a delay of the torque given together, when the two came within
+    /// [`super::replicate::NEAR`] of each other ([`super::lag_or_delay`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lag_or_delay: Option<Mixture>,
 }
 
 /// The whole diagnosis.

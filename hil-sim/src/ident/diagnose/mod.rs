@@ -39,6 +39,7 @@ pub mod contenders;
 pub mod decimate;
 pub mod describe;
 pub mod diagnosis;
+pub mod lag_or_delay;
 pub mod leak;
 pub mod level_map;
 pub mod locate;
@@ -185,6 +186,7 @@ fn diagnose_at_rate(
             after: kept.after,
             test: kept.test,
             replication: kept.replication,
+            lag_or_delay: kept.lag_or_delay,
             bic_gain: kept.scored.bic_gain,
             y_span,
             rate: &dx,

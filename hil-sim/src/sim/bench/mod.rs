@@ -81,6 +81,9 @@ pub enum Set {
     /// An eleventh held-out range, first run for the same report as fresh9, with the same
     /// method: the ranges differ by more than the change measured on one of them.
     Fresh10,
+    /// A twelfth held-out range, first run for the report of 2026-11-27 (a field lag and a
+    /// delay given together to settle a tie between them; a finding's least held-out drop).
+    Fresh11,
 }
 
 impl Set {
@@ -98,6 +101,7 @@ impl Set {
         ("fresh8", Set::Fresh8),
         ("fresh9", Set::Fresh9),
         ("fresh10", Set::Fresh10),
+        ("fresh11", Set::Fresh11),
     ];
 
     /// The seed of case `k` of this set.
@@ -115,6 +119,7 @@ impl Set {
             Set::Fresh8 => 34_000_000 + 37 * k,
             Set::Fresh9 => 38_000_000 + 41 * k,
             Set::Fresh10 => 46_000_000 + 43 * k,
+            Set::Fresh11 => 54_000_000 + 47 * k,
         }
     }
 }
