@@ -155,6 +155,15 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
                         )
                     })
                     .unwrap_or_default(),
+                c.lag_or_delay
+                    .map(|m| {
+                        format!(
+                            "least error at {:.0} % of the {} delay",
+                            100.0 * m.best_share,
+                            with_unit(1e3 * m.delay_s, 3, "ms")
+                        )
+                    })
+                    .unwrap_or_default(),
                 if c.kept { "kept".into() } else { String::new() },
             ]
         })
@@ -163,12 +172,22 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
         "Every candidate tested, by round, by BIC gain (kept: of those that pass the held-out block test, the one with \
          the lowest held-out error). Reversed split: a candidate the held-out tail left undecided, or close to another \
          effect's, refitted with the first part of the recording held out instead; its gain there and the signed-rank p \
-         over the blocks of both held-out parts:",
+         over the blocks of both held-out parts. Lag and delay together: a field lag and a delay of the torque close \
+         on the held-out tail, the input given a share of the delay with the lag tuned on top; the share where the \
+         training error is least names the effect (below half the lag, above it the delay):",
     );
-    rep.table(
-        &["round", "effect", "term", "BIC gain", "held-out R-RMSE (%)", "t-statistic", "reversed split", ""],
-        &tested,
-    );
+    let headers = [
+        "round",
+        "effect",
+        "term",
+        "BIC gain",
+        "held-out R-RMSE (%)",
+        "t-statistic",
+        "reversed split",
+        "lag and delay together",
+        "",
+    ];
+    rep.table(&headers, &tested);
 }
 
 /// A finding's value with its unit: from the finding's `units`, else from the name's suffix.
