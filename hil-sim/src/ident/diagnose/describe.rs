@@ -180,9 +180,10 @@ pub fn finding(d: &Described<'_>) -> Finding {
 /// How a tie between a field lag and a delay of the torque was settled, in words.
 fn mixture_clause(m: &Mixture, effect: &str) -> String {
     let rival = if effect == "field_lag" { "a delay of the torque" } else { "a lag of the field" };
+    let settled = if m.side().is_some() { "" } else { ", which does not tell them apart" };
     format!(
         " (it came within {:.0} % of {rival} on the held-out tail; given both at once, the training error is least \
-         with {:.0} % of the {} delay)",
+         with {:.0} % of the {} delay{settled})",
         100.0 * super::replicate::NEAR,
         100.0 * m.best_share,
         with_unit(1e3 * m.delay_s, "ms")

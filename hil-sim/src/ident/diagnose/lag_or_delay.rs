@@ -30,7 +30,7 @@ pub struct Mixture {
     /// Per share of [`SHARES`]: the lag tuned on top (s; 0 at the last share, which has none)…
     pub lag_s: [f64; 5],
     /// …and the training part's mean squared error relative to the least of them (≥ 1;
-    /// infinite where the refit diverged).
+    /// infinite, `null` in the JSON, where the refit diverged).
     pub relative_mse: [f64; 5],
     /// The share where the error is least.
     pub best_share: f64,
