@@ -153,11 +153,18 @@ impl Dataset {
 
     /// Training samples that enter the fit.
     pub fn train_rows(&self) -> Vec<usize> {
-        self.spans()
-            .iter()
-            .flat_map(|r| r.start..r.train_end)
-            .filter(|&i| !self.excluded.get(i).copied().unwrap_or(false) && self.usable(i))
-            .collect()
+        self.spans().iter().flat_map(|r| r.start..r.train_end).filter(|&i| self.enters_fit(i)).collect()
+    }
+
+    /// Whether sample `i` may enter a fit: neither flagged by the quality checks nor a gross
+    /// outlier.
+    pub fn enters_fit(&self, i: usize) -> bool {
+        !self.flagged(i) && self.usable(i)
+    }
+
+    /// Whether the quality checks flagged sample `i`.
+    pub fn flagged(&self, i: usize) -> bool {
+        self.excluded.get(i).copied().unwrap_or(false)
     }
 
     /// Every held-out sample that may be scored (the `validate` runs of a dataset, or the
@@ -173,11 +180,7 @@ impl Dataset {
 
     /// Held-out samples the quality checks did not flag.
     pub fn heldout_unflagged(&self) -> Vec<usize> {
-        self.spans()
-            .iter()
-            .flat_map(|r| r.train_end..r.end)
-            .filter(|&i| !self.excluded.get(i).copied().unwrap_or(false))
-            .collect()
+        self.spans().iter().flat_map(|r| r.train_end..r.end).filter(|&i| !self.flagged(i)).collect()
     }
 
     /// `rows` without the samples a delay of `ds` samples leaves uncovered at either end of

@@ -164,12 +164,17 @@ fn ready(data: &Dataset, fit: FitResult) -> Result<Base, DiagnoseError> {
 
 /// The training and held-out (unflagged) rows away from the ends.
 pub fn rows(data: &Dataset) -> (Vec<usize>, Vec<usize>) {
+    let inside = inside(data);
+    let train = data.train_rows().into_iter().filter(&inside).collect();
+    let held = data.heldout_unflagged().into_iter().filter(&inside).collect();
+    (train, held)
+}
+
+/// Whether a row is [`MARGIN_S`] (and two samples) away from both ends of the recording.
+fn inside(data: &Dataset) -> impl Fn(&usize) -> bool {
     let n = data.len();
     let margin = (MARGIN_S / data.dt).ceil() as usize + 2;
-    let inside = |i: &usize| *i >= margin && *i + margin < n;
-    let train = data.train_rows().into_iter().filter(inside).collect();
-    let held = data.heldout_unflagged().into_iter().filter(inside).collect();
-    (train, held)
+    move |i: &usize| *i >= margin && *i + margin < n
 }
 
 /// The models start from rest: the reversed split's head is scored from this long after a
@@ -182,16 +187,13 @@ const WARM_UP_S: f64 = 1.0;
 /// its held-out tail is held out and the rest trains; the head is scored after the models'
 /// start-up ([`WARM_UP_S`]).
 pub fn reversed_rows(data: &Dataset) -> (Vec<usize>, Vec<usize>) {
-    let n = data.len();
-    let margin = (MARGIN_S / data.dt).ceil() as usize + 2;
-    let inside = |i: &usize| *i >= margin && *i + margin < n;
-    let flagged = |i: &usize| data.excluded.get(*i).copied().unwrap_or(false);
+    let inside = inside(data);
     let (mut train, mut held) = (Vec::new(), Vec::new());
     for r in data.spans() {
         let head_end = r.start + (r.end - r.train_end);
         let warm_up = ((WARM_UP_S / data.dt) as usize).min((head_end - r.start) / 3);
-        held.extend((r.start + warm_up..head_end).filter(|i| inside(i) && !flagged(i)));
-        train.extend((head_end..r.end).filter(|i| inside(i) && !flagged(i) && data.usable(*i)));
+        held.extend((r.start + warm_up..head_end).filter(|i| inside(i) && !data.flagged(*i)));
+        train.extend((head_end..r.end).filter(|i| inside(i) && data.enters_fit(*i)));
     }
     (train, held)
 }
