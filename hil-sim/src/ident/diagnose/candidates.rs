@@ -510,6 +510,13 @@ fn auxiliary(s: &InputStats, a: &AuxChannel) -> Candidate {
 }
 
 impl Candidate {
+    /// The box its value is refitted in: its grid's ends.
+    pub fn bounds(&self) -> (f64, f64) {
+        let lo = self.grid.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = self.grid.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        (lo, hi)
+    }
+
     /// The transforms and terms of `current` with this candidate's piece at value `g` added.
     pub fn on_top(&self, current: &Fitted, g: f64) -> (Vec<Transform>, Vec<Term>) {
         let piece = (self.build)(g);

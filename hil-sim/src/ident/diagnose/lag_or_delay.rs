@@ -79,7 +79,7 @@ pub fn profile(prob: &Problem<'_>, reference: &Fitted, lag: Refitted<'_>, delay:
             } else {
                 (delay.0, delay_s, &delay.1.fitted.theta)
             };
-            let (lo, hi) = bounds(c);
+            let (lo, hi) = c.bounds();
             let build = |g: f64| {
                 let p = (c.build)(g);
                 (p.transform, p.terms)
@@ -105,18 +105,11 @@ pub fn profile(prob: &Problem<'_>, reference: &Fitted, lag: Refitted<'_>, delay:
     Some(Mixture { delay_s, lag_s, relative_mse, best_share: SHARES[k] })
 }
 
-/// The box of a candidate's value: its grid's ends.
-fn bounds(c: &Candidate) -> (f64, f64) {
-    let lo = c.grid.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = c.grid.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    (lo, hi)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::ident::dataset::prepare_recording;
-    use crate::ident::diagnose::{base, candidates, rank, DiagnoseOptions};
+    use crate::ident::diagnose::tests::round_one;
     use crate::ident::fit::Dataset;
     use crate::sim::bench::{generate, Case};
 
@@ -139,27 +132,13 @@ mod tests {
     /// The profile of round 1's two-pole lag against its delay, on a Bouc–Wen base fitted to
     /// `data`.
     fn profiled(data: &Dataset) -> Mixture {
-        let opts = DiagnoseOptions { model: Some("bouc_wen".into()), ..Default::default() };
-        let bases = base::fit_bases(data, &["bouc_wen"], &opts, &crate::progress::NoProgress).unwrap();
-        let b = &bases.contenders[0];
-        let (train, _) = base::rows(data);
-        let prob = Problem {
-            data,
-            sim: b.sim.as_ref(),
-            spec: &b.spec,
-            rate: b.fit.rate_choice,
-            train,
-            rate_cutoff_hz: crate::numerics::derivative::CUTOFF_OF_FS / data.dt,
-        };
-        let current = prob.refit(&[], &[], None, &b.fit.flat, 8).unwrap().0;
-        let reference = rank::reference(&prob, &current).unwrap();
-        let cands = candidates::all(data, &candidates::classify(data, vec![], None), false);
-        let (reference, ranked) = rank::rank(&prob, &cands, &reference, &[]).unwrap();
-        let pick = |label: &str| {
-            let k = cands.iter().position(|c| c.label.starts_with(label)).unwrap();
-            (&cands[k], ranked.iter().find(|s| s.index == k).unwrap())
-        };
-        profile(&prob, &reference, pick("two-pole lag"), pick("time shift")).unwrap()
+        round_one(data, |prob, cands, reference, ranked| {
+            let pick = |label: &str| {
+                let k = cands.iter().position(|c| c.label.starts_with(label)).unwrap();
+                (&cands[k], ranked.iter().find(|s| s.index == k).unwrap())
+            };
+            profile(prob, reference, pick("two-pole lag"), pick("time shift")).unwrap()
+        })
     }
 
     #[test]

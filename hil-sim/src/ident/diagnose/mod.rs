@@ -276,6 +276,8 @@ pub type InputTransform = Transform;
 mod tests {
     use super::*;
     use crate::models::RateSpec;
+    use augment::{Fitted, Problem};
+    use candidates::Candidate;
     use rand::{Rng, SeedableRng};
 
     /// A bouc_wen recording of a three-tone input; the model is fed the input through
@@ -334,6 +336,30 @@ mod tests {
             rates: None,
             runs: Vec::new(),
         }
+    }
+
+    /// Round 1 on a Bouc–Wen base fitted to `data`, as a diagnosis runs it: `f` gets the
+    /// problem, the candidates, the round's reference and their ranking.
+    pub(super) fn round_one<T>(
+        data: &Dataset,
+        f: impl FnOnce(&Problem<'_>, &[Candidate], &Fitted, &[rank::Scored]) -> T,
+    ) -> T {
+        let opts = DiagnoseOptions { model: Some("bouc_wen".into()), ..Default::default() };
+        let bases = base::fit_bases(data, &["bouc_wen"], &opts, &crate::progress::NoProgress).unwrap();
+        let b = &bases.contenders[0];
+        let prob = Problem {
+            data,
+            sim: b.sim.as_ref(),
+            spec: &b.spec,
+            rate: b.fit.rate_choice,
+            train: base::rows(data).0,
+            rate_cutoff_hz: crate::numerics::derivative::CUTOFF_OF_FS / data.dt,
+        };
+        let current = prob.refit(&[], &[], None, &b.fit.flat, 8).unwrap().0;
+        let reference = rank::reference(&prob, &current).unwrap();
+        let cands = candidates::all(data, &candidates::classify(data, vec![], None), false);
+        let (reference, ranked) = rank::rank(&prob, &cands, &reference, &[]).unwrap();
+        f(&prob, &cands, &reference, &ranked)
     }
 
     fn run(data: &Dataset) -> Diagnosis {

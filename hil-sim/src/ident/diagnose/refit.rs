@@ -22,8 +22,7 @@ pub fn refit_candidate(
         let p = (c.build)(g);
         (p.transform, p.terms)
     };
-    let lo = c.grid.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = c.grid.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let (lo, hi) = c.bounds();
     starts
         .iter()
         .filter_map(|(g, theta)| {

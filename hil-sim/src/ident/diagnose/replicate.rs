@@ -99,32 +99,18 @@ impl<'p, 'a> Reversed<'p, 'a> {
 mod tests {
     use super::*;
     use crate::ident::diagnose::augment::Transform;
-    use crate::ident::diagnose::tests::recording;
-    use crate::ident::diagnose::{base, candidates, rank, DiagnoseOptions};
+    use crate::ident::diagnose::tests::{recording, round_one};
 
     /// The first-order field lag candidate of round 1 on a Bouc–Wen base, replicated on the
     /// reversed split of `data`.
     fn lag_replicated(data: &crate::ident::fit::Dataset) -> Replication {
-        let opts = DiagnoseOptions { model: Some("bouc_wen".into()), ..Default::default() };
-        let bases = base::fit_bases(data, &["bouc_wen"], &opts, &crate::progress::NoProgress).unwrap();
-        let b = &bases.contenders[0];
-        let (train, held) = base::rows(data);
-        let prob = Problem {
-            data,
-            sim: b.sim.as_ref(),
-            spec: &b.spec,
-            rate: b.fit.rate_choice,
-            train,
-            rate_cutoff_hz: crate::numerics::derivative::CUTOFF_OF_FS / data.dt,
-        };
-        let current = prob.refit(&[], &[], None, &b.fit.flat, 8).unwrap().0;
-        let reference = rank::reference(&prob, &current).unwrap();
-        let cands = candidates::all(data, &candidates::classify(data, vec![], None), false);
-        let k = cands.iter().position(|c| c.label.starts_with("first-order lag")).unwrap();
-        let (reference, ranked) = rank::rank(&prob, &cands, &reference, &[]).unwrap();
-        let s = ranked.iter().find(|s| s.index == k).unwrap();
-        let tail = significance::blocks(&data.output, &reference.pred, &s.fitted.pred, &held);
-        Reversed::new(&prob, &reference).replicate(&cands[k], s, &tail).unwrap()
+        round_one(data, |prob, cands, reference, ranked| {
+            let k = cands.iter().position(|c| c.label.starts_with("first-order lag")).unwrap();
+            let s = ranked.iter().find(|s| s.index == k).unwrap();
+            let (_, held) = crate::ident::diagnose::base::rows(data);
+            let tail = significance::blocks(&data.output, &reference.pred, &s.fitted.pred, &held);
+            Reversed::new(prob, reference).replicate(&cands[k], s, &tail).unwrap()
+        })
     }
 
     #[test]
