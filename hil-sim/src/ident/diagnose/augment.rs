@@ -2,12 +2,15 @@
 //! plus terms linear in their coefficients β,
 //!
 //! ```text
-//! ŷ(t) = m_θ(T(x))(t) + Σ_k β_k · φ_k(t),      φ_k = v_k  or  φ_k = m_θ · v_k
+//! ŷ(t) = m_θ(T(x))(t) + Σ_k β_k · φ_k(t),      φ_k = v_k,  m_θ · v_k  or  g_k(T(x))
 //! ```
 //!
 //! `T` chains the input transforms the catalog names (delay, first-order lag, saturating
 //! map, offset); the terms are the additive ones (`c·|ẋ|ẋ`, `m·ẍ`, `c_ω·ω`, …) and the
 //! multiplicative ones, a parameter scaled by a slow or auxiliary signal (`m·(θ − θ̄)`).
+//! The base's own terms that are maps of the input (play operators, the level power:
+//! [`InputMap`]) are made again from `T(x)` at every refit: the field a candidate saturates,
+//! lags or delays is the field the whole base responds to.
 //!
 //! A refit is a damped Gauss–Newton step on θ jointly with the least-squares β: the base
 //! model's Jacobian by forward differences through the f32 core (one run per free
@@ -79,6 +82,30 @@ pub struct Term {
     /// `v_k` (one value per sample; empty for [`TermKind::OutputSaturation`]).
     pub values: Vec<f64>,
     pub kind: TermKind,
+    /// When the values are a map of the input: made again from the transformed input at
+    /// every refit, so that an input transform reaches the term as it reaches the base model.
+    pub of_input: Option<InputMap>,
+}
+
+/// A term that is part of the base model's static or hysteretic response to the input
+/// (the play operators, the level power): the field a candidate transforms (saturated,
+/// lagged, delayed) is the field this term responds to as well.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum InputMap {
+    /// A play operator of radius `radius` (input units), [`super::contenders::play`].
+    Play { radius: f64 },
+    /// `x_ref·sgn(x)·|x/x_ref|^p`, [`super::level_map`].
+    LevelPower { x_ref: f64, p: f64 },
+}
+
+impl InputMap {
+    /// The term's values for the input `x`.
+    pub fn values(&self, x: &[f64]) -> Vec<f64> {
+        match *self {
+            Self::Play { radius } => super::contenders::play(x, radius),
+            Self::LevelPower { x_ref, p } => x.iter().map(|v| x_ref * v.signum() * (v.abs() / x_ref).powf(p)).collect(),
+        }
+    }
 }
 
 /// How a term's column is made from its values and the base model's output `m`.
@@ -96,13 +123,18 @@ pub enum TermKind {
 
 impl Term {
     pub fn additive(name: impl Into<String>, values: Vec<f64>) -> Self {
-        Self { name: name.into(), values, kind: TermKind::Additive }
+        Self { name: name.into(), values, kind: TermKind::Additive, of_input: None }
+    }
+    /// An additive term `map(x)` of the input `x` (the recorded one: a refit makes it again
+    /// from the transformed input).
+    pub fn of_input(name: impl Into<String>, map: InputMap, x: &[f64]) -> Self {
+        Self { name: name.into(), values: map.values(x), kind: TermKind::Additive, of_input: Some(map) }
     }
     pub fn scaling(name: impl Into<String>, values: Vec<f64>) -> Self {
-        Self { name: name.into(), values, kind: TermKind::TimesModel }
+        Self { name: name.into(), values, kind: TermKind::TimesModel, of_input: None }
     }
     pub fn output_saturation(name: impl Into<String>, t_sat: f64) -> Self {
-        Self { name: name.into(), values: Vec::new(), kind: TermKind::OutputSaturation { t_sat } }
+        Self { name: name.into(), values: Vec::new(), kind: TermKind::OutputSaturation { t_sat }, of_input: None }
     }
     fn column(&self, m: &[f64]) -> std::borrow::Cow<'_, [f64]> {
         use std::borrow::Cow;
@@ -212,7 +244,9 @@ impl AugSim<'_, '_> {
             transforms.extend(tr);
             terms.extend(extra);
         }
-        let kin = self.prob.kin(&transforms)?;
+        let x = self.prob.transformed(&transforms);
+        let kin = self.prob.kin_of(&x)?;
+        let terms = through(terms, &x);
         let v = std::sync::Arc::new((kin, transforms, terms));
         if let Ok(mut c) = self.cache.lock() {
             c.insert(0, (g.to_bits(), std::sync::Arc::clone(&v)));
@@ -266,18 +300,28 @@ impl Problem<'_> {
         self.run_kin(theta, &kin)
     }
 
-    fn kin(&self, transforms: &[Transform]) -> Option<Vec<model_core::Kin>> {
+    /// The recorded input through `transforms`.
+    fn transformed(&self, transforms: &[Transform]) -> Vec<f64> {
         let mut x = self.data.input.clone();
         for t in transforms {
             x = t.apply(&x, self.data.dt);
         }
+        x
+    }
+
+    fn kin(&self, transforms: &[Transform]) -> Option<Vec<model_core::Kin>> {
+        self.kin_of(&self.transformed(transforms))
+    }
+
+    /// The base model's kinematics for the (transformed) input `x`.
+    fn kin_of(&self, x: &[f64]) -> Option<Vec<model_core::Kin>> {
         // Given rates are the zero-phase ones: recomputed for the transformed input.
         let rates = self
             .data
             .rates
             .as_ref()
-            .map(|_| crate::numerics::derivative::rates_below(&x, self.data.dt, self.rate_cutoff_hz));
-        let samples = crate::models::replay::samples_with_rates(&x, self.data.command.as_deref(), rates.as_ref());
+            .map(|_| crate::numerics::derivative::rates_below(x, self.data.dt, self.rate_cutoff_hz));
+        let samples = crate::models::replay::samples_with_rates(x, self.data.command.as_deref(), rates.as_ref());
         kinematics(&samples, self.data.dt as f32, self.rate)
     }
 
@@ -421,7 +465,9 @@ impl Problem<'_> {
     /// Jacobian `jac` (taken at the current transforms) stands in for the refit of θ. One
     /// run of the base model, for scanning a candidate's grid cheaply.
     pub fn scan_cost(&self, transforms: &[Transform], terms: &[Term], theta: &[f64], jac: &[Vec<f64>]) -> Option<f64> {
-        let m = self.run(theta, transforms)?;
+        let x = self.transformed(transforms);
+        let m = self.run_kin(theta, &self.kin_of(&x)?)?;
+        let terms = through(terms.to_vec(), &x);
         let term_cols: Vec<std::borrow::Cow<'_, [f64]>> = terms.iter().map(|t| t.column(&m)).collect();
         let cols: Vec<&[f64]> = jac.iter().map(Vec::as_slice).chain(term_cols.iter().map(|c| &**c)).collect();
         let target: Vec<f64> = self.data.output.iter().zip(&m).map(|(y, m)| y - m).collect();
@@ -434,6 +480,16 @@ impl Problem<'_> {
         let m0 = self.run_kin(theta, &kin)?;
         Some(self.jacobian(theta, &kin, &m0))
     }
+}
+
+/// `terms` with the maps of the input made again from the transformed input `x`.
+fn through(mut terms: Vec<Term>, x: &[f64]) -> Vec<Term> {
+    for t in &mut terms {
+        if let Some(map) = t.of_input {
+            t.values = map.values(x);
+        }
+    }
+    terms
 }
 
 #[cfg(test)]
@@ -455,5 +511,23 @@ mod tests {
         let s = Transform::Saturate { b_sat: 0.5 }.apply(&[2.0, -2.0, 0.0], dt);
         assert!(s[0] < 0.5 && s[0] > 0.49 && s[1] == -s[0] && s[2] == 0.0);
         assert_eq!(Transform::Offset { b_0: 0.1 }.apply(&[1.0], dt), vec![0.9]);
+    }
+
+    #[test]
+    fn a_map_of_the_input_is_made_again_from_the_transformed_input_and_nothing_else_is() {
+        let x: Vec<f64> = (0..300).map(|i| 0.8 * (i as f64 * 0.03).sin()).collect();
+        let seen = Transform::Saturate { b_sat: 0.4 }.apply(&x, 1e-3);
+        let level = InputMap::LevelPower { x_ref: 0.8, p: 1.5 };
+        let terms = vec![
+            Term::of_input("play", InputMap::Play { radius: 0.1 }, &x),
+            Term::of_input("level", level, &x),
+            Term::additive("fixed", x.clone()),
+        ];
+        let after = through(terms, &seen);
+        assert_eq!(after[0].values, super::super::contenders::play(&seen, 0.1));
+        assert_eq!(after[1].values, level.values(&seen));
+        assert!((after[1].values[52] - 0.8 * (seen[52] / 0.8).powf(1.5)).abs() < 1e-12);
+        assert_eq!(after[2].values, x);
+        assert_ne!(after[0].values, super::super::contenders::play(&x, 0.1));
     }
 }

@@ -159,7 +159,25 @@ fn ready(data: &Dataset, fit: FitResult) -> Result<Base, DiagnoseError> {
     if !matches!(spec.strategy, Strategy::Linear | Strategy::Local | Strategy::Global) {
         return Err(DiagnoseError::NotParametric(id));
     }
-    Ok(Base { fit, sim, spec })
+    Ok(Base { fit, sim, spec: without_bend_over(spec) })
+}
+
+/// Parameters (model id, name) whose negative values bend a base's static curve over at
+/// high input: the algebraic model's `α·|B|·B³` with α < 0 flattens the torque at the top
+/// of the field as a saturation does, and with play operators beside it absorbed every
+/// concealed saturation it was the base of. The refits hold them ≥ 0, as the level term's
+/// β ([`super::level_map`]): a curve levelling off is left for the rounds to name.
+pub const NO_BEND_OVER: &[(&str, &str)] = &[(models::algebraic::Registered::ID, "alpha")];
+
+/// `spec` with the [`NO_BEND_OVER`] parameters held ≥ 0.
+fn without_bend_over(mut spec: ModelSpec) -> ModelSpec {
+    let id = spec.id;
+    for p in spec.params.iter_mut().filter(|p| NO_BEND_OVER.contains(&(id, p.name))) {
+        p.lo = p.lo.max(0.0);
+        p.hi = p.hi.max(p.lo);
+        p.start = p.start.clamp(p.lo, p.hi);
+    }
+    spec
 }
 
 /// The training and held-out (unflagged) rows away from the ends.
@@ -201,6 +219,19 @@ pub fn reversed_rows(data: &Dataset) -> (Vec<usize>, Vec<usize>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_algebraic_base_may_not_bend_its_curve_over_and_the_others_keep_their_box() {
+        let data = crate::ident::diagnose::tests::recording(None, 3);
+        let spec = |id: &str| crate::models::host(id).and_then(|h| h.spec(&data.scales(), None)).unwrap();
+        let (raw, held) = (spec("algebraic"), without_bend_over(spec("algebraic")));
+        let param = |s: &ModelSpec, name: &str| s.params.iter().find(|p| p.name == name).cloned().unwrap();
+        assert!(param(&raw, "alpha").lo < 0.0);
+        let alpha = param(&held, "alpha");
+        assert!(alpha.lo == 0.0 && alpha.hi == param(&raw, "alpha").hi && alpha.start >= 0.0);
+        assert_eq!(param(&held, "k"), param(&raw, "k"));
+        assert_eq!(without_bend_over(spec("bouc_wen")).params, spec("bouc_wen").params);
+    }
 
     #[test]
     fn the_reversed_split_holds_out_the_head_as_long_as_the_tail() {

@@ -16,7 +16,7 @@
 use rayon::prelude::*;
 
 use super::accept::{Judge, Verdict};
-use super::augment::{Fitted, Problem, Term};
+use super::augment::{Fitted, InputMap, Problem, Term};
 use super::base::{Base, Bases, PLAY_HOST};
 use super::candidates::Candidate;
 use super::locate::{self, Locate};
@@ -31,7 +31,7 @@ const BASE_ITERATIONS: usize = 8;
 
 /// A play operator (backlash) of radius `r`: its output follows `x` within `±r`, starting
 /// at `x[0]`.
-fn play(x: &[f64], r: f64) -> Vec<f64> {
+pub fn play(x: &[f64], r: f64) -> Vec<f64> {
     let mut s = x.first().copied().unwrap_or(0.0);
     x.iter()
         .map(|v| {
@@ -48,7 +48,10 @@ fn play(x: &[f64], r: f64) -> Vec<f64> {
 pub fn plays(x: &[f64]) -> Vec<Term> {
     let (lo, hi) = crate::numerics::stats::min_max(x);
     let span = if hi > lo { hi - lo } else { 0.0 };
-    PLAY_RADII.iter().map(|f| Term::additive(format!("play_{:.0}pct", 100.0 * f), play(x, f * span))).collect()
+    PLAY_RADII
+        .iter()
+        .map(|f| Term::of_input(format!("play_{:.0}pct", 100.0 * f), InputMap::Play { radius: f * span }, x))
+        .collect()
 }
 
 /// One contender after its first round.
@@ -261,6 +264,11 @@ mod tests {
     /// radii unlike [`PLAY_RADII`] on a linear static curve, as no seed model has it), the
     /// field seen through `lag_s` (0: none), with white noise of 0.5 % of the span.
     fn play_clutch(lag_s: f64, seed: u64) -> crate::ident::fit::Dataset {
+        play_clutch_seeing(super::super::augment::Transform::Lag { tau_s: lag_s }, seed)
+    }
+
+    /// [`play_clutch`] with the field seen through `seen`.
+    fn play_clutch_seeing(seen: super::super::augment::Transform, seed: u64) -> crate::ident::fit::Dataset {
         let (dt, n) = (1e-3, 12_000);
         let time: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
         let tone = |t: f64, f: f64, a: f64, ph: f64| a * (std::f64::consts::TAU * f * t + ph).sin();
@@ -268,7 +276,7 @@ mod tests {
             .iter()
             .map(|&t| 0.35 + tone(t, 1.3, 0.15, 0.0) + tone(t, 4.1, 0.07, 1.0) + tone(t, 9.7, 0.03, 2.0))
             .collect();
-        let seen = super::super::augment::Transform::Lag { tau_s: lag_s }.apply(&x, dt);
+        let seen = seen.apply(&x, dt);
         let hyst: Vec<Vec<f64>> = [(0.008, 3.0), (0.025, 2.0), (0.05, 1.5)]
             .iter()
             .map(|(r, w)| play(&seen, *r).iter().map(|p| w * p).collect())
@@ -294,5 +302,15 @@ mod tests {
     fn on_that_loop_a_field_lag_is_still_named() {
         let (found, notes) = effects(&play_clutch(0.006, 6));
         assert_eq!(found.first().map(String::as_str), Some("field_lag"), "{found:?} {notes:?}");
+    }
+
+    #[test]
+    fn on_that_loop_a_saturating_field_is_named() {
+        // The whole clutch, its plays included, sees the field levelling off: 15 % lower at
+        // the top of the field (0.6). The plays follow the saturated field in the refit, and
+        // the algebraic host cannot bend its own curve over to absorb it.
+        let sat = super::super::augment::Transform::Saturate { b_sat: 0.8 };
+        let (found, notes) = effects(&play_clutch_seeing(sat, 7));
+        assert_eq!(found.first().map(String::as_str), Some("saturation"), "{found:?} {notes:?}");
     }
 }

@@ -8,9 +8,11 @@
 //! reported as a note, not as a finding. The term is added to the output, not fed through
 //! the model (a power of the input would also scale the model's rate terms with the level),
 //! and only with `β > 0`: it cannot bend the curve the other way, so a saturation (a
-//! concave map) stays for the rounds to find.
+//! concave map) stays for the rounds to find. It is a map of the input
+//! ([`super::augment::InputMap`]): a candidate's transform of the input (a saturating map,
+//! a lag, a delay) reaches it as it reaches the base model.
 
-use super::augment::{Fitted, Problem, Term, Tune};
+use super::augment::{Fitted, InputMap, Problem, Term, Tune};
 
 /// The exponents tried.
 pub const P_MIN: f64 = 1.1;
@@ -28,10 +30,7 @@ pub fn fit(prob: &Problem<'_>, current: &Fitted, heldout_rmse: impl Fn(&[f64]) -
     }
     let reference = prob.refit(&current.transforms, &current.terms, None, &current.theta, ITERATIONS)?.0;
     let x = &prob.data.input;
-    let build = move |p: f64| {
-        let v: Vec<f64> = x.iter().map(|v| x_ref * v.signum() * (v.abs() / x_ref).powf(p)).collect();
-        (None, vec![Term::additive("level_power", v)])
-    };
+    let build = move |p: f64| (None, vec![Term::of_input("level_power", InputMap::LevelPower { x_ref, p }, x)]);
     let tune = Tune { build: &build, start: 1.5, lo: P_MIN, hi: P_MAX, log: false };
     let (with_map, p) = prob.refit(&current.transforms, &current.terms, Some(&tune), &current.theta, ITERATIONS)?;
     let beta = with_map.beta.get(current.terms.len()).copied().unwrap_or(0.0);

@@ -84,6 +84,10 @@ pub enum Set {
     /// A twelfth held-out range, first run for the report of 2026-11-27 (a field lag and a
     /// delay given together to settle a tie between them; a finding's least held-out drop).
     Fresh11,
+    /// A thirteenth held-out range, first run for the report of 2026-11-27 (the base's maps
+    /// of the input, plays and level power, follow a candidate's transform of it; the
+    /// algebraic base may not bend its own curve over).
+    Fresh12,
 }
 
 impl Set {
@@ -102,6 +106,7 @@ impl Set {
         ("fresh9", Set::Fresh9),
         ("fresh10", Set::Fresh10),
         ("fresh11", Set::Fresh11),
+        ("fresh12", Set::Fresh12),
     ];
 
     /// The seed of case `k` of this set.
@@ -120,6 +125,7 @@ impl Set {
             Set::Fresh9 => 38_000_000 + 41 * k,
             Set::Fresh10 => 46_000_000 + 43 * k,
             Set::Fresh11 => 54_000_000 + 47 * k,
+            Set::Fresh12 => 62_000_000 + 53 * k,
         }
     }
 }
