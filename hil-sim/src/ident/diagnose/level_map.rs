@@ -9,8 +9,9 @@
 //! the model (a power of the input would also scale the model's rate terms with the level),
 //! and only with `β > 0`: it cannot bend the curve the other way, so a saturation (a
 //! concave map) stays for the rounds to find. It is a map of the input
-//! ([`super::augment::InputMap`]): a candidate's transform of the input (a saturating map,
-//! a lag, a delay) reaches it as it reaches the base model.
+//! ([`super::augment::InputMap`]): a candidate's lag or delay of the input reaches it as it
+//! reaches the base model (a saturating map or an offset does not: composed with the one
+//! exponent fitted here it would be a second curvature, [`super::augment::InputMap::follows`]).
 
 use super::augment::{Fitted, InputMap, Problem, Term, Tune};
 
