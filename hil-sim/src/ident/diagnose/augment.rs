@@ -82,9 +82,11 @@ pub struct Term {
     /// `v_k` (one value per sample; empty for [`TermKind::OutputSaturation`]).
     pub values: Vec<f64>,
     pub kind: TermKind,
-    /// When the values are a map of the input: made again from the transformed input at
-    /// every refit, so that an input transform reaches the term as it reaches the base model.
-    pub of_input: Option<InputMap>,
+    /// When the values are a map of the input: the map and its values on the recorded input.
+    /// Made again from the transformed input at every refit, so that an input transform
+    /// reaches the term as it reaches the base model (most refits transform nothing: then
+    /// the recorded values are copied, not made again).
+    pub of_input: Option<(InputMap, std::sync::Arc<Vec<f64>>)>,
 }
 
 /// A term that is part of the base model's response to the input (the play operators, the
@@ -142,7 +144,9 @@ impl Term {
     /// An additive term `map(x)` of the input `x` (the recorded one: a refit makes it again
     /// from the transformed input).
     pub fn of_input(name: impl Into<String>, map: InputMap, x: &[f64]) -> Self {
-        Self { name: name.into(), values: map.values(x), kind: TermKind::Additive, of_input: Some(map) }
+        let values = map.values(x);
+        let recorded = std::sync::Arc::new(values.clone());
+        Self { name: name.into(), values, kind: TermKind::Additive, of_input: Some((map, recorded)) }
     }
     pub fn scaling(name: impl Into<String>, values: Vec<f64>) -> Self {
         Self { name: name.into(), values, kind: TermKind::TimesModel, of_input: None }
@@ -327,8 +331,10 @@ impl Problem<'_> {
     /// `transforms` each follows ([`InputMap::follows`]; `x`: through all of them).
     fn through(&self, mut terms: Vec<Term>, transforms: &[Transform], x: &[f64]) -> Vec<Term> {
         for t in &mut terms {
-            let Some(map) = t.of_input else { continue };
-            t.values = if transforms.iter().all(|tr| map.follows(tr)) {
+            let Some((map, recorded)) = &t.of_input else { continue };
+            t.values = if !transforms.iter().any(|tr| map.follows(tr)) {
+                recorded.as_ref().clone()
+            } else if transforms.iter().all(|tr| map.follows(tr)) {
                 map.values(x)
             } else {
                 let followed: Vec<Transform> = transforms.iter().filter(|tr| map.follows(tr)).cloned().collect();
