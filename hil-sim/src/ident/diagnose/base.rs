@@ -135,10 +135,11 @@ pub fn fit_bases(
     let scored: Vec<(&str, f64)> = fits.iter().map(|r| (r.model.as_str(), score(r))).collect();
     let keep = pick(&scored);
     let host = fits.iter().find(|r| opts.model.is_none() && r.model == PLAY_HOST).cloned();
-    let play_host = host.and_then(|f| ready(data, f).ok());
+    let held = opts.model.is_none();
+    let play_host = host.and_then(|f| ready(data, f, held).ok());
     let mut contenders = Vec::with_capacity(keep.len());
     for (k, fit) in fits.into_iter().enumerate().filter(|(k, _)| keep.contains(k)) {
-        match ready(data, fit) {
+        match ready(data, fit, held) {
             Ok(b) => contenders.push(b),
             // The best base must be refittable; another contender that is not is left out.
             Err(e) if k == 0 => return Err(e),
@@ -148,8 +149,9 @@ pub fn fit_bases(
     Ok(Bases { contenders, play_host, tried, failed: errors })
 }
 
-/// The simulator and search space of the fitted base `fit`.
-fn ready(data: &Dataset, fit: FitResult) -> Result<Base, DiagnoseError> {
+/// The simulator and search space of the fitted base `fit`; with `held` (`auto`), the
+/// [`NO_BEND_OVER`] parameters held ≥ 0.
+fn ready(data: &Dataset, fit: FitResult, held: bool) -> Result<Base, DiagnoseError> {
     let id = fit.model.clone();
     let sim = crate::ident::fit::simulate::simulator(&id, data.dt as f32)
         .ok_or_else(|| DiagnoseError::NotParametric(id.clone()))?;
@@ -159,14 +161,17 @@ fn ready(data: &Dataset, fit: FitResult) -> Result<Base, DiagnoseError> {
     if !matches!(spec.strategy, Strategy::Linear | Strategy::Local | Strategy::Global) {
         return Err(DiagnoseError::NotParametric(id));
     }
-    Ok(Base { fit, sim, spec: without_bend_over(spec) })
+    Ok(Base { fit, sim, spec: if held { without_bend_over(spec) } else { spec } })
 }
 
 /// Parameters (model id, name) whose negative values bend a base's static curve over at
 /// high input: the algebraic model's `α·|B|·B³` with α < 0 flattens the torque at the top
 /// of the field as a saturation does, and with play operators beside it absorbed every
-/// concealed saturation it was the base of. The refits hold them ≥ 0, as the level term's
-/// β ([`super::level_map`]): a curve levelling off is left for the rounds to name.
+/// concealed saturation it was the base of. With `auto` the refits hold them ≥ 0, as the
+/// level term's β ([`super::level_map`]): a curve levelling off is left for the rounds to
+/// name. A base the user names (`--model algebraic`) is taken as given, its curve free to
+/// bend over: `simulate --base algebraic`'s own truth has α < 0 (a clutch's curve fitted
+/// by it), and on such a recording a held α named its own curve a saturation.
 pub const NO_BEND_OVER: &[(&str, &str)] = &[(models::algebraic::Registered::ID, "alpha")];
 
 /// `spec` with the [`NO_BEND_OVER`] parameters held ≥ 0.
