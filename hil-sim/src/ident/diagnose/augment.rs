@@ -94,7 +94,7 @@ pub struct Term {
 /// well, and the plays see a saturated or offset field too.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum InputMap {
-    /// A play operator of radius `radius` (input units), [`super::contenders::play`].
+    /// A play operator of radius `radius` (input units), [`play`].
     Play { radius: f64 },
     /// `x_ref·sgn(x)·|x/x_ref|^p`, [`super::level_map`].
     LevelPower { x_ref: f64, p: f64 },
@@ -104,7 +104,7 @@ impl InputMap {
     /// The term's values for the input `x`.
     pub fn values(&self, x: &[f64]) -> Vec<f64> {
         match *self {
-            Self::Play { radius } => super::contenders::play(x, radius),
+            Self::Play { radius } => play(x, radius),
             Self::LevelPower { x_ref, p } => x.iter().map(|v| x_ref * v.signum() * (v.abs() / x_ref).powf(p)).collect(),
         }
     }
@@ -122,6 +122,18 @@ impl InputMap {
             }
         }
     }
+}
+
+/// A play operator (backlash) of radius `r`: its output follows `x` within `±r`, starting
+/// at `x[0]`.
+pub fn play(x: &[f64], r: f64) -> Vec<f64> {
+    let mut s = x.first().copied().unwrap_or(0.0);
+    x.iter()
+        .map(|v| {
+            s = s.max(v - r).min(v + r);
+            s
+        })
+        .collect()
 }
 
 /// How a term's column is made from its values and the base model's output `m`.
@@ -566,8 +578,8 @@ mod tests {
         ];
         let after = prob.through(terms, &both, &seen);
         // The plays follow both; the level term the lag only; the plain term neither.
-        assert_eq!(after[0].values, super::super::contenders::play(&seen, 0.1));
-        assert_ne!(after[0].values, super::super::contenders::play(&x, 0.1));
+        assert_eq!(after[0].values, play(&seen, 0.1));
+        assert_ne!(after[0].values, play(&x, 0.1));
         assert_eq!(after[1].values, level.values(&lagged));
         assert!((after[1].values[52] - 0.8 * (lagged[52] / 0.8).powf(1.5)).abs() < 1e-12);
         assert_eq!(after[2].values, x);

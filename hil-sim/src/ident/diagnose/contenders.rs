@@ -29,18 +29,6 @@ pub const PLAY_RADII: &[f64] = &[0.01, 0.03, 0.07, 0.15];
 /// Gauss–Newton iterations that converge a fitted base before its first round.
 const BASE_ITERATIONS: usize = 8;
 
-/// A play operator (backlash) of radius `r`: its output follows `x` within `±r`, starting
-/// at `x[0]`.
-pub fn play(x: &[f64], r: f64) -> Vec<f64> {
-    let mut s = x.first().copied().unwrap_or(0.0);
-    x.iter()
-        .map(|v| {
-            s = s.max(v - r).min(v + r);
-            s
-        })
-        .collect()
-}
-
 /// Rate-independent hysteresis as terms linear in their weights (a Prandtl–Ishlinskii sum of
 /// play operators of the input `x`, radii [`PLAY_RADII`] × its span): a loop that no seed
 /// model's family has and that no catalog effect is (its width does not grow with the rate,
@@ -247,6 +235,7 @@ fn note(openings: &[Opening<'_>], chosen: usize, judge: &Judge<'_>, cands: &[Can
 
 #[cfg(test)]
 mod tests {
+    use super::super::augment::play;
     use super::*;
     use crate::ident::diagnose::{diagnose, DiagnoseOptions};
     use rand::SeedableRng;
