@@ -84,7 +84,8 @@ impl Judge<'_> {
                 .sqrt();
             let change_of_noise = change / self.noise_rms.max(1e-300);
             let resolvable = change_of_noise >= significance::MIN_TERM_OF_NOISE;
-            let impossible = super::physical::impossible(c, f, reference.terms.len(), s.value, self.dt);
+            let impossible =
+                super::physical::impossible(c, f, reference.terms.len(), s.value, self.dt, &prob.data.input);
             let otherwise = impossible.is_none()
                 && s.bic_gain > 0.0
                 && f.train_mse < reference.train_mse

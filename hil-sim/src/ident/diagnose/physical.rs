@@ -1,6 +1,8 @@
 //! Whether a candidate's fitted values are physically possible: a finding is never a
 //! negative mass or inertia, a time constant or saturation level that is not positive, a
 //! yield-stress saturation that expands the torque instead or turns it down at the top,
+//! a loop that narrows as the input grows (the catalog's asymmetry is a loop *widening* with
+//! the input; one narrowing at high level is the yield stress levelling off, a saturation),
 //! or a lag, delay or channel lag pinned at the edge of its search range (the refit
 //! wanted more than the range allows: the term is standing in for something else).
 
@@ -10,9 +12,14 @@ use super::candidates::Candidate;
 /// Why the fitted candidate is impossible (in words, with the value and its unit), or
 /// `None` when it is possible. `n_old` is the number of terms the reference already had;
 /// `dt` the sample interval (s): a delay shorter than one sample is no finding, since a base
-/// model stepped once per sample lags its own state by up to that much.
-pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64) -> Option<String> {
+/// model stepped once per sample lags its own state by up to that much; `x` the input.
+pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64, x: &[f64]) -> Option<String> {
     let coef = f.beta.get(n_old).copied().unwrap_or(0.0);
+    if c.effect == "asymmetry" {
+        if let Some(why) = f.terms.get(n_old).and_then(|t| narrowing_loop(&t.name, coef, x)) {
+            return Some(why);
+        }
+    }
     if c.effect == "inertia" && coef < 0.0 {
         return Some(format!("a negative mass or inertia ({})", crate::numerics::number::num(coef, 4)));
     }
@@ -61,6 +68,28 @@ pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64) 
     }
 }
 
+/// Why an asymmetry term of coefficient `coef` makes the loop *narrower* as the input `x`
+/// moves to its far end, if it does. The term `δ·(x − x̄)·sgn(ẋ)` adds `2δ·(x − x̄)` to the
+/// loop's width: on a one-sided input (or one whose two sides differ by more than half) it
+/// must widen towards the largest |x|; on a balanced two-sided input either sign is a
+/// preference of one polarity, possible. `δ₂·(x − x̄)²·sgn(ẋ)` must widen away from x̄.
+fn narrowing_loop(term: &str, coef: f64, x: &[f64]) -> Option<String> {
+    let (lo, hi) = crate::numerics::stats::min_max(x);
+    let far = if hi.abs() >= lo.abs() { hi } else { lo };
+    let balanced = lo < 0.0 && hi > 0.0 && lo.abs().min(hi) >= 0.5 * lo.abs().max(hi);
+    let narrows = match term {
+        "delta" => !balanced && coef * (far - crate::numerics::stats::mean(x)) < 0.0,
+        "delta2" => coef < 0.0,
+        _ => false,
+    };
+    narrows.then(|| {
+        format!(
+            "a loop narrowing as the input grows ({term} = {}): the torque levelling off at high level, a saturation's sign",
+            crate::numerics::number::num(coef, 4)
+        )
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -96,10 +125,27 @@ mod tests {
         // positive for k below 1.1.
         let why = |k: f64| {
             let (c, f) = case(k);
-            impossible(&c, &f, 0, 2.0, 1e-3)
+            impossible(&c, &f, 0, 2.0, 1e-3, &[])
         };
         assert_eq!(why(1.0), None);
         assert!(why(1.5).is_some_and(|w| w.contains("turns the torque down")), "{:?}", why(1.5));
         assert!(why(-0.2).is_some_and(|w| w.contains("growing faster")), "{:?}", why(-0.2));
+    }
+
+    #[test]
+    fn an_asymmetry_may_widen_the_loop_with_the_input_but_not_narrow_it() {
+        let one_sided: Vec<f64> = (0..=100).map(|i| 0.05 + 0.005 * f64::from(i)).collect();
+        let two_sided: Vec<f64> = (0..=100).map(|i| -0.5 + 0.01 * f64::from(i)).collect();
+        let mostly_negative: Vec<f64> = one_sided.iter().map(|v| 0.1 - v).collect();
+        assert_eq!(narrowing_loop("delta", 0.3, &one_sided), None);
+        assert!(narrowing_loop("delta", -0.3, &one_sided).is_some_and(|w| w.contains("saturation")));
+        // On a field of the other polarity the far end is the most negative one.
+        assert_eq!(narrowing_loop("delta", -0.3, &mostly_negative), None);
+        assert!(narrowing_loop("delta", 0.3, &mostly_negative).is_some());
+        // A balanced two-sided field: either sign favours one polarity.
+        assert_eq!(narrowing_loop("delta", -0.3, &two_sided), None);
+        assert!(narrowing_loop("delta2", -0.3, &two_sided).is_some());
+        assert_eq!(narrowing_loop("delta2", 0.3, &one_sided), None);
+        assert_eq!(narrowing_loop("c_rate", -0.3, &one_sided), None);
     }
 }
