@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::plot::{self, colour, PlotError, Series, Style};
 use super::Report;
-use crate::ident::diagnose::diagnosis::{Diagnosis, Finding, PlotData};
+use crate::ident::diagnose::diagnosis::{Diagnosis, Finding, PlotData, Tested};
 use crate::ident::diagnose::locate;
 use crate::numerics::number::{num, with_unit};
 use crate::numerics::units::unit_of;
@@ -164,13 +164,13 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
                         )
                     })
                     .unwrap_or_default(),
-                if c.kept { "kept".into() } else { String::new() },
+                outcome(c),
             ]
         })
         .collect();
     rep.paragraph(
         "Every candidate tested, by round, by BIC gain (kept: of those that pass the held-out block test, the one with \
-         the lowest held-out error). Reversed split: a candidate the held-out tail left undecided, or close to another \
+         the lowest held-out error; not possible: fitted values no physical cause has, never kept). Reversed split: a candidate the held-out tail left undecided, or close to another \
          effect's, refitted with the first part of the recording held out instead; its gain there and the signed-rank p \
          over the blocks of both held-out parts. Lag and delay together: a field lag and a delay of the torque close \
          on the held-out tail, the input given a share of the delay with the lag tuned on top; the share where the \
@@ -185,9 +185,18 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
         "t-statistic",
         "reversed split",
         "lag and delay together",
-        "",
+        "kept or why not",
     ];
     rep.table(&headers, &tested);
+}
+
+/// The candidates table's last cell: kept, or why its fitted values rule it out.
+fn outcome(c: &Tested) -> String {
+    match (&c.impossible, c.kept) {
+        (_, true) => "kept".into(),
+        (Some(why), false) => format!("not possible: {why}"),
+        (None, false) => String::new(),
+    }
 }
 
 /// A finding's value with its unit: from the finding's `units`, else from the name's suffix.
@@ -284,4 +293,35 @@ fn band_chart(rep: &mut Report, dir: &Path, stem: &str, p: &PlotData, unit: &str
         ),
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ident::diagnose::significance::Test;
+
+    #[test]
+    fn a_candidate_ruled_out_by_its_values_says_why_in_the_table() {
+        let test = Test { t: 7.0, gain: 0.34, blocks_better: 10, blocks: 10, p_rank: 0.001, significant: true };
+        let mut c = Tested {
+            round: 1,
+            effect: "asymmetry".into(),
+            label: "loading/unloading difference growing with the input".into(),
+            value: None,
+            bic_gain: 21_000.0,
+            heldout_r_rmse_before: 0.0355,
+            heldout_r_rmse_after: 0.0235,
+            test,
+            change_of_noise: 13.5,
+            kept: false,
+            impossible: Some("a loop narrowing as the input grows (delta = -1.2)".into()),
+            replication: None,
+            lag_or_delay: None,
+        };
+        assert_eq!(outcome(&c), "not possible: a loop narrowing as the input grows (delta = -1.2)");
+        c.impossible = None;
+        assert_eq!(outcome(&c), "");
+        c.kept = true;
+        assert_eq!(outcome(&c), "kept");
+    }
 }

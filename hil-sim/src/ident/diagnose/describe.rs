@@ -219,9 +219,12 @@ fn what(d: &Described<'_>) -> String {
             -g / dt
         ),
         "saturation" if c.grid_name.as_deref() == Some("t_sat") => format!(
-            "the {o} levels off at high level whatever the {i} does (the fluid's yield stress saturating): above its floor it follows u/√(1 + (u/T_s)²) of the model's, T_s = {} ({} of that map)",
+            "the {o} levels off at high level whatever the {i} does (the fluid's yield stress saturating): above its floor it follows u/√(1 + (u/T_s)²) of the model's, T_s = {} ({} of that map{})",
             with_unit(g, &yu),
-            with_unit(100.0 * coef, "%")
+            with_unit(100.0 * coef, "%"),
+            yield_equivalent(g, coef)
+                .map(|t| format!("; at small u the map itself at T_s/√k = {}", with_unit(t, &yu)))
+                .unwrap_or_default()
         ),
         "saturation" if c.label.contains("knee") => format!(
             "the {i} saturates with a sharp knee: the {o} follows b/(1 + (b/b_s)⁴)^¼ with b_s = {} (steel saturating over a narrow range of the field)",
@@ -343,6 +346,34 @@ fn inertia(coef: f64, yu: &str, chu: &str) -> String {
 }
 
 /// `v` with 4 significant digits (a power of ten written out, never e-notation) and its unit.
+/// The level `T_s/√k` at which the map itself, `u/√(1 + (u/T)²)`, compresses a small `u` as the
+/// yield-stress term `u + k·(u/√(1 + (u/T_s)²) − u)` does (both `u − u³/(2T²)` to third order);
+/// `None` unless `k > 0`.
+fn yield_equivalent(t_sat: f64, k: f64) -> Option<f64> {
+    (k > 0.0 && t_sat > 0.0).then(|| t_sat / k.sqrt())
+}
+
 fn with_unit(v: f64, unit: &str) -> String {
     crate::numerics::number::with_unit(v, 4, unit)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_yield_stress_term_reads_as_the_map_at_its_equivalent_level() {
+        let sat = |u: f64, t: f64| u / (1.0 + (u / t).powi(2)).sqrt();
+        for (t_sat, k) in [(108.4, 20.99), (5.0, 0.5), (40.0, 3.0)] {
+            let t = yield_equivalent(t_sat, k).unwrap();
+            for share in [0.05, 0.1, 0.2] {
+                let u = share * t;
+                let term = u + k * (sat(u, t_sat) - u);
+                // Equal to third order: the difference is of fifth order, (share)⁴ of u.
+                assert!((term - sat(u, t)).abs() <= 2.0 * share.powi(4) * u, "{t_sat} {k} {share}");
+            }
+        }
+        assert_eq!(yield_equivalent(10.0, -0.2), None);
+        assert_eq!(yield_equivalent(10.0, 0.0), None);
+    }
 }
