@@ -170,8 +170,9 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
         .collect();
     rep.paragraph(
         "Every candidate tested, by round, by BIC gain (kept: of those that pass the held-out block test, the one with \
-         the lowest held-out error; not possible: fitted values no physical cause has, never kept). Reversed split: a candidate the held-out tail left undecided, or close to another \
-         effect's, refitted with the first part of the recording held out instead; its gain there and the signed-rank p \
+         the lowest held-out error; not possible: fitted values no physical cause has, never kept). Reversed split: a \
+         candidate the held-out tail left undecided, or close to another effect's, refitted with the first part of the \
+         recording held out instead; its gain there and the signed-rank p \
          over the blocks of both held-out parts. Lag and delay together: a field lag and a delay of the torque close \
          on the held-out tail, the input given a share of the delay with the lag tuned on top; the share where the \
          training error is least names the effect (below half the lag, above it the delay):",

@@ -345,7 +345,6 @@ fn inertia(coef: f64, yu: &str, chu: &str) -> String {
     }
 }
 
-/// `v` with 4 significant digits (a power of ten written out, never e-notation) and its unit.
 /// The level `T_s/√k` at which the map itself, `u/√(1 + (u/T)²)`, compresses a small `u` as the
 /// yield-stress term `u + k·(u/√(1 + (u/T_s)²) − u)` does (both `u − u³/(2T²)` to third order);
 /// `None` unless `k > 0`.
@@ -353,6 +352,7 @@ fn yield_equivalent(t_sat: f64, k: f64) -> Option<f64> {
     (k > 0.0 && t_sat > 0.0).then(|| t_sat / k.sqrt())
 }
 
+/// `v` with 4 significant digits (a power of ten written out, never e-notation) and its unit.
 fn with_unit(v: f64, unit: &str) -> String {
     crate::numerics::number::with_unit(v, 4, unit)
 }

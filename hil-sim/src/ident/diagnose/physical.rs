@@ -90,7 +90,7 @@ fn narrowing_loop(term: &str, coef: f64, x: &[f64]) -> Option<String> {
     };
     narrows.then(|| {
         format!(
-            "a loop narrowing as the input grows ({term} = {}): the torque levelling off at high level, a saturation's sign",
+            "a loop narrowing as the input grows ({term} = {}): the output levelling off at high level, a saturation's sign",
             crate::numerics::number::num(coef, 4)
         )
     })
