@@ -378,6 +378,11 @@ fn transform(
     }
 }
 
+/// Names of the direction terms' coefficients, `δ·(x − x̄)·sgn(ẋ)` and `δ₂·(x − x̄)²·sgn(ẋ)`
+/// ([`super::physical`] judges their signs by these names).
+pub const DIRECTION_TERM: &str = "delta";
+pub const DIRECTION_SQUARED_TERM: &str = "delta2";
+
 /// Rate dependence in three shapes (`c·|ẋ|ẋ`, `c·ẋ³`, and a damping that grows with the
 /// local excitation frequency, `c·(f_loc/f̄ − 1)·ẋ`: the catalog's α(f), beyond the linear
 /// `c·ẋ` a base already has), direction in two shapes (`δ·(x − x̄)·sgn(ẋ)` and
@@ -399,11 +404,11 @@ fn kinematic_terms(s: &InputStats, aux: &[AuxChannel]) -> Vec<Candidate> {
         additive("rate_dependence", "term in |rate|·rate".into(), "c_rate", rate_term, None),
         additive("rate_dependence", "term in rate³".into(), "c_rate3", cubed, None),
         frequency_damping(s),
-        additive("asymmetry", "loading/unloading difference growing with the input".into(), "delta", asym, None),
+        additive("asymmetry", "loading/unloading difference growing with the input".into(), DIRECTION_TERM, asym, None),
         additive(
             "asymmetry",
             "loading/unloading difference growing with the input squared".into(),
-            "delta2",
+            DIRECTION_SQUARED_TERM,
             asym2,
             None,
         ),

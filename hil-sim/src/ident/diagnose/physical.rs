@@ -7,7 +7,7 @@
 //! wanted more than the range allows: the term is standing in for something else).
 
 use super::augment::Fitted;
-use super::candidates::Candidate;
+use super::candidates::{Candidate, DIRECTION_SQUARED_TERM, DIRECTION_TERM};
 
 /// A field whose negative side reaches at most this share of its top is of positive polarity
 /// (crossing zero only by an offset or noise).
@@ -84,8 +84,8 @@ fn narrowing_loop(term: &str, coef: f64, x: &[f64]) -> Option<String> {
     let (lo, hi) = crate::numerics::stats::min_max(x);
     let positive = hi > 0.0 && lo >= -ONE_SIDED * hi;
     let narrows = match term {
-        "delta" => positive && coef < 0.0,
-        "delta2" => coef < 0.0,
+        DIRECTION_TERM => positive && coef < 0.0,
+        DIRECTION_SQUARED_TERM => coef < 0.0,
         _ => false,
     };
     narrows.then(|| {
@@ -146,17 +146,17 @@ mod tests {
         // A bench recording's field of negative polarity, -0.50 to 0.045 T.
         let mostly_negative: Vec<f64> = (0..=100).map(|i| -0.5 + 0.00545 * f64::from(i)).collect();
         let two_sided: Vec<f64> = (0..=100).map(|i| -0.5 + 0.01 * f64::from(i)).collect();
-        assert_eq!(narrowing_loop("delta", 0.3, &positive), None);
-        assert!(narrowing_loop("delta", -0.3, &positive).is_some_and(|w| w.contains("saturation")));
-        assert!(narrowing_loop("delta", -0.3, &crossing_by_noise).is_some());
+        assert_eq!(narrowing_loop(DIRECTION_TERM, 0.3, &positive), None);
+        assert!(narrowing_loop(DIRECTION_TERM, -0.3, &positive).is_some_and(|w| w.contains("saturation")));
+        assert!(narrowing_loop(DIRECTION_TERM, -0.3, &crossing_by_noise).is_some());
         // Where the catalog's signed δ·x and a width growing with |x| part, either sign.
         for x in [&negative, &mostly_negative, &two_sided] {
-            assert_eq!(narrowing_loop("delta", -0.3, x), None);
-            assert_eq!(narrowing_loop("delta", 0.3, x), None);
+            assert_eq!(narrowing_loop(DIRECTION_TERM, -0.3, x), None);
+            assert_eq!(narrowing_loop(DIRECTION_TERM, 0.3, x), None);
         }
-        assert!(narrowing_loop("delta2", -0.3, &two_sided).is_some());
-        assert!(narrowing_loop("delta2", -0.3, &positive).is_some());
-        assert_eq!(narrowing_loop("delta2", 0.3, &positive), None);
+        assert!(narrowing_loop(DIRECTION_SQUARED_TERM, -0.3, &two_sided).is_some());
+        assert!(narrowing_loop(DIRECTION_SQUARED_TERM, -0.3, &positive).is_some());
+        assert_eq!(narrowing_loop(DIRECTION_SQUARED_TERM, 0.3, &positive), None);
         assert_eq!(narrowing_loop("c_rate", -0.3, &positive), None);
     }
 }
