@@ -12,10 +12,11 @@
 //! - [`bench_table`] (ignored, about 25 minutes): the full table, per effect and per
 //!   excitation: `BENCH_SET=heldout cargo test --release -p integration-tests --test
 //!   diagnose_concealed -- --ignored --nocapture` (`BENCH_SET=dev` for the development
-//!   seeds, `fresh` … `fresh16` for the second to seventeenth held-out ranges; `BENCH_N`,
+//!   seeds, `fresh` … `fresh18` for the second to nineteenth held-out ranges; `BENCH_N`,
 //!   `BENCH_NULL` for the number of effect and null cases, default 256 and 48;
 //!   `BENCH_MIN_FS`, `BENCH_MAX_FS` keep only the cases sampled within those rates, Hz;
-//!   `BENCH_SEEDS=a,b,…` only the cases with those seeds; `BENCH_WRITE=DIR` writes each case's
+//!   `BENCH_SEEDS=a,b,…` only the cases with those seeds, `BENCH_EFFECTS=e,…` only those
+//!   concealing these effects; `BENCH_WRITE=DIR` writes each case's
 //!   recording to `DIR/<seed>.csv`, to diagnose it by hand). It prints one line per case and writes
 //!   `target/bench_<set>.md`; `BENCH_DUMP=FILE` appends a JSON line per case (the case,
 //!   the findings, every candidate tested with its statistics) for studying a decision rule
@@ -220,7 +221,7 @@ fn blind_subset_of_heldout_seeds() {
 }
 
 #[test]
-#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh16|dev, BENCH_N, BENCH_NULL"]
+#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh18|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
     let sets = Set::NAMED;
     let key = std::env::var("BENCH_SET").ok();
@@ -235,10 +236,14 @@ fn bench_table() {
     let only: Vec<u64> = std::env::var("BENCH_SEEDS")
         .map(|v| v.split(',').filter_map(|s| s.trim().parse().ok()).collect())
         .unwrap_or_default();
+    // BENCH_EFFECTS: only the cases concealing these effects (comma-separated; `none` for the nulls).
+    let effects: Vec<String> =
+        std::env::var("BENCH_EFFECTS").map(|v| v.split(',').map(|s| s.trim().to_owned()).collect()).unwrap_or_default();
     let all: Vec<Case> = cases(set, n, n_null)
         .into_iter()
         .filter(|c| c.fs_hz >= fs.0 && c.fs_hz <= fs.1)
         .filter(|c| only.is_empty() || only.contains(&c.seed))
+        .filter(|c| effects.is_empty() || effects.contains(&c.effect))
         .collect();
     let (from, to) = (env("BENCH_FROM", 0).min(all.len()), env("BENCH_TO", all.len()).min(all.len()));
     let outcomes = run_all(&all[from..to.max(from)]);

@@ -382,17 +382,23 @@ fn transform(
 /// ([`super::physical`] judges their signs by these names).
 pub const DIRECTION_TERM: &str = "delta";
 pub const DIRECTION_SQUARED_TERM: &str = "delta2";
+/// Name of the loading-branch term's coefficient, `δ_l·(x − x_min)·(1 + sgn(ẋ))/2`.
+pub const LOADING_TERM: &str = "delta_loading";
 
 /// Rate dependence in three shapes (`c·|ẋ|ẋ`, `c·ẋ³`, and a damping that grows with the
 /// local excitation frequency, `c·(f_loc/f̄ − 1)·ẋ`: the catalog's α(f), beyond the linear
 /// `c·ẋ` a base already has), direction in two shapes (`δ·(x − x̄)·sgn(ẋ)` and
-/// `δ₂·(x − x̄)²·sgn(ẋ)`, the sign smoothed over 5 % of the rate's spread) and inertia (`m·ẍ`, from a measured acceleration when there is one).
+/// `δ₂·(x − x̄)²·sgn(ẋ)`, the sign smoothed over 5 % of the rate's spread) and gated
+/// (`δ_l·(x − x_min)·(1 + sgn(ẋ))/2`: the loading branch alone lifted, the catalog's
+/// sigmoid-gated variant) and inertia (`m·ẍ`, from a measured acceleration when there is one).
 fn kinematic_terms(s: &InputStats, aux: &[AuxChannel]) -> Vec<Candidate> {
     let rate_term: Vec<f64> = s.dx.iter().map(|v| v.abs() * v).collect();
     let cubed: Vec<f64> = s.dx.iter().map(|v| v * v * v).collect();
     let direction: Vec<f64> = s.dx.iter().map(|d| (d / (0.05 * s.dx_std)).tanh()).collect();
     let asym: Vec<f64> = s.x.iter().zip(&direction).map(|(x, d)| (x - s.x_mean) * d).collect();
     let asym2: Vec<f64> = s.x.iter().zip(&direction).map(|(x, d)| (x - s.x_mean).powi(2) * d).collect();
+    let x_min = s.x.iter().copied().fold(f64::INFINITY, f64::min);
+    let loading: Vec<f64> = s.x.iter().zip(&direction).map(|(x, d)| (x - x_min) * 0.5 * (1.0 + d)).collect();
     let acc = aux.iter().find(|a| a.role == Role::InputAcceleration);
     let (acc_values, acc_label, acc_channel) = match acc {
         Some(a) => {
@@ -412,6 +418,7 @@ fn kinematic_terms(s: &InputStats, aux: &[AuxChannel]) -> Vec<Candidate> {
             asym2,
             None,
         ),
+        additive("asymmetry", "loading branch lifted with the input".into(), LOADING_TERM, loading, None),
         additive("inertia", acc_label, "m", acc_values, acc_channel),
     ]
 }

@@ -7,7 +7,7 @@
 use std::collections::BTreeMap;
 
 use super::augment::Fitted;
-use super::candidates::Candidate;
+use super::candidates::{Candidate, DIRECTION_SQUARED_TERM, DIRECTION_TERM, LOADING_TERM};
 use super::diagnosis::{Evidence, Finding, Tested};
 use super::lag_or_delay::Mixture;
 use super::locate::{self, Condition};
@@ -315,8 +315,8 @@ fn coefficient_unit(name: &str, (i, o): (&str, &str), ch: Option<&str>) -> Optio
         "c_rate" => format!("{yu} per ({xu}/s)²"),
         "c_rate3" => format!("{yu} per ({xu}/s)³"),
         "c_freq" => format!("{yu} per ({xu}/s)"),
-        "delta" | "k_input" => format!("{yu} per {xu}"),
-        "delta2" => format!("{yu} per ({xu})²"),
+        DIRECTION_TERM | LOADING_TERM | "k_input" => format!("{yu} per {xu}"),
+        DIRECTION_SQUARED_TERM => format!("{yu} per ({xu})²"),
         "m" if ch.is_some() => format!("{yu} per ({cu})"),
         "m" => format!("{yu} per ({xu}/s²)"),
         "j" if yu == "N·m" && cu == "rad/s" => "kg·m²".to_owned(),

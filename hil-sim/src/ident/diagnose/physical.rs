@@ -7,7 +7,7 @@
 //! wanted more than the range allows: the term is standing in for something else).
 
 use super::augment::Fitted;
-use super::candidates::{Candidate, DIRECTION_SQUARED_TERM, DIRECTION_TERM};
+use super::candidates::{Candidate, DIRECTION_SQUARED_TERM, DIRECTION_TERM, LOADING_TERM};
 
 /// A field whose negative side reaches at most this share of its top is of positive polarity
 /// (crossing zero only by an offset or noise).
@@ -79,12 +79,14 @@ pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64, 
 /// ("loop width growing with the input") and the physics (a width growing with |x|) both
 /// widen it. On a negative or two-sided field the two readings part (the catalog's signed
 /// `δ·x` with δ > 0 narrows the loop towards a large negative field), so either sign is
-/// possible there. `δ₂·(x − x̄)²·sgn(ẋ)` must widen away from x̄ (a saturation narrows both ends).
+/// possible there. The loading branch lifted, `δ_l·(x − x_min)·(1 + sgn(ẋ))/2`, widens the
+/// loop by `δ_l·(x − x_min)` and is judged alike. `δ₂·(x − x̄)²·sgn(ẋ)` must widen away
+/// from x̄ (a saturation narrows both ends).
 fn narrowing_loop(term: &str, coef: f64, x: &[f64]) -> Option<String> {
     let (lo, hi) = crate::numerics::stats::min_max(x);
     let positive = hi > 0.0 && lo >= -ONE_SIDED * hi;
     let narrows = match term {
-        DIRECTION_TERM => positive && coef < 0.0,
+        DIRECTION_TERM | LOADING_TERM => positive && coef < 0.0,
         DIRECTION_SQUARED_TERM => coef < 0.0,
         _ => false,
     };
@@ -149,6 +151,9 @@ mod tests {
         assert_eq!(narrowing_loop(DIRECTION_TERM, 0.3, &positive), None);
         assert!(narrowing_loop(DIRECTION_TERM, -0.3, &positive).is_some_and(|w| w.contains("saturation")));
         assert!(narrowing_loop(DIRECTION_TERM, -0.3, &crossing_by_noise).is_some());
+        assert!(narrowing_loop(LOADING_TERM, -0.3, &positive).is_some());
+        assert_eq!(narrowing_loop(LOADING_TERM, 0.3, &positive), None);
+        assert_eq!(narrowing_loop(LOADING_TERM, -0.3, &two_sided), None);
         // Where the catalog's signed δ·x and a width growing with |x| part, either sign.
         for x in [&negative, &mostly_negative, &two_sided] {
             assert_eq!(narrowing_loop(DIRECTION_TERM, -0.3, x), None);

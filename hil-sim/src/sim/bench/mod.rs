@@ -100,6 +100,10 @@ pub enum Set {
     /// A seventeenth held-out range, first run for the same report, after fresh15 showed the
     /// narrowing-loop rule misapplied to a lopsided two-sided field.
     Fresh16,
+    /// An eighteenth held-out range, first run for the report of 2026-11-28.
+    Fresh17,
+    /// A nineteenth held-out range, kept for a second run of the same report.
+    Fresh18,
 }
 
 impl Set {
@@ -123,6 +127,8 @@ impl Set {
         ("fresh14", Set::Fresh14),
         ("fresh15", Set::Fresh15),
         ("fresh16", Set::Fresh16),
+        ("fresh17", Set::Fresh17),
+        ("fresh18", Set::Fresh18),
     ];
 
     /// The seed of case `k` of this set.
@@ -146,6 +152,8 @@ impl Set {
             Set::Fresh14 => 78_000_000 + 61 * k,
             Set::Fresh15 => 86_000_000 + 67 * k,
             Set::Fresh16 => 94_000_000 + 71 * k,
+            Set::Fresh17 => 102_000_000 + 73 * k,
+            Set::Fresh18 => 110_000_000 + 79 * k,
         }
     }
 }
