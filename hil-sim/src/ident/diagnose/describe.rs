@@ -254,6 +254,10 @@ fn what(d: &Described<'_>) -> String {
             "loading and unloading differ by an amount growing with the square of the {i} (δ₂ = {} per ({xu})²)",
             with_unit(coef, &yu)
         ),
+        "asymmetry" if c.label.starts_with("loading branch") => format!(
+            "the loading branch alone is lifted by an amount growing with the {i} above its floor (δ_l = {} per {xu})",
+            with_unit(coef, &yu)
+        ),
         "asymmetry" => {
             format!("loading and unloading differ by an amount growing with the {i} (δ = {} per {xu})", with_unit(coef, &yu))
         }

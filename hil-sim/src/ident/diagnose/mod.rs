@@ -495,6 +495,9 @@ mod tests {
         let d = run(&with_noise(x, &y, &mut rng));
         let top = d.findings.first().unwrap_or_else(|| panic!("no finding: {:#?}", d.candidates));
         assert_eq!(top.effect, "asymmetry", "{:#?}", d.candidates);
+        assert!(top.summary.contains("loading branch alone"), "{}", top.summary);
+        let delta = top.params.get(candidates::LOADING_TERM).copied().expect("the loading-branch term");
+        assert!(delta > 0.0, "δ_l = {delta}: the loading branch was lifted");
     }
 
     #[test]
