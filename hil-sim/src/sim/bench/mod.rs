@@ -102,7 +102,8 @@ pub enum Set {
     Fresh16,
     /// An eighteenth held-out range, first run for the report of 2026-11-28.
     Fresh17,
-    /// A nineteenth held-out range, kept for a second run of the same report.
+    /// A nineteenth held-out range, first run for the same report as fresh17, with the same
+    /// method.
     Fresh18,
 }
 
