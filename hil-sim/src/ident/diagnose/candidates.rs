@@ -397,7 +397,7 @@ fn kinematic_terms(s: &InputStats, aux: &[AuxChannel]) -> Vec<Candidate> {
     let direction: Vec<f64> = s.dx.iter().map(|d| (d / (0.05 * s.dx_std)).tanh()).collect();
     let asym: Vec<f64> = s.x.iter().zip(&direction).map(|(x, d)| (x - s.x_mean) * d).collect();
     let asym2: Vec<f64> = s.x.iter().zip(&direction).map(|(x, d)| (x - s.x_mean).powi(2) * d).collect();
-    let x_min = s.x.iter().copied().fold(f64::INFINITY, f64::min);
+    let x_min = min_max(&s.x).0;
     let loading: Vec<f64> = s.x.iter().zip(&direction).map(|(x, d)| (x - x_min) * 0.5 * (1.0 + d)).collect();
     let acc = aux.iter().find(|a| a.role == Role::InputAcceleration);
     let (acc_values, acc_label, acc_channel) = match acc {

@@ -317,6 +317,17 @@ mod tests {
         out.y.iter().map(|v| f64::from(*v)).collect()
     }
 
+    /// `n` samples of uniform white noise from `rng` through four zero-phase first-order
+    /// low-passes at `hz` (sampled every `dt` s), scaled to a peak of 1.
+    fn band_limited(rng: &mut impl Rng, n: usize, dt: f64, hz: f64) -> Vec<f64> {
+        let mut white: Vec<f64> = (0..n).map(|_| rng.random::<f64>() - 0.5).collect();
+        for _ in 0..4 {
+            white = crate::numerics::derivative::filtfilt(&white, 1.0 / (2.0 * std::f64::consts::PI * hz * dt));
+        }
+        let peak = white.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        white.iter().map(|v| v / peak).collect()
+    }
+
     /// A 1 kHz dataset of the input `x` and the output `y` with uniform white noise of 0.5 %
     /// of its span (RMS) drawn from `rng`; the first 70 % trains.
     pub(super) fn with_noise(x: Vec<f64>, y: &[f64], rng: &mut impl Rng) -> Dataset {
@@ -409,12 +420,7 @@ mod tests {
         // ḃ = 0, and a 2–4 ms lag of the input, which smooths them, was named.
         let mut rng = rand::rngs::StdRng::seed_from_u64(21);
         let (dt, n) = (1e-3, 20_000);
-        let mut white: Vec<f64> = (0..n).map(|_| rng.random::<f64>() - 0.5).collect();
-        for _ in 0..4 {
-            white = crate::numerics::derivative::filtfilt(&white, 1.0 / (2.0 * std::f64::consts::PI * 6.0 * dt));
-        }
-        let peak = white.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let b: Vec<f64> = white.iter().map(|v| 0.3 + 0.25 * v / peak).collect();
+        let b: Vec<f64> = band_limited(&mut rng, n, dt, 6.0).iter().map(|v| 0.3 + 0.25 * v).collect();
         let db = crate::numerics::derivative::gradient(&b, dt);
         let y: Vec<f64> = b.iter().zip(&db).map(|(b, d)| 0.8 + 22.0 * b + 0.01 * d + 1.5 * (0.6 * d).tanh()).collect();
         let step = 2.0 / 4096.0;
@@ -476,21 +482,14 @@ mod tests {
         // δ·(b − b̄)·sgn ḃ, was beaten by a |ḃ|·ḃ term on two fresh16 recordings.
         let mut rng = rand::rngs::StdRng::seed_from_u64(13);
         let (dt, n) = (1e-3, 12_000);
-        let mut white: Vec<f64> = (0..n).map(|_| rng.random::<f64>() - 0.5).collect();
-        for _ in 0..4 {
-            white = crate::numerics::derivative::filtfilt(&white, 1.0 / (2.0 * std::f64::consts::PI * 5.0 * dt));
-        }
-        let peak = white.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        let x: Vec<f64> = white.iter().map(|v| 1.0 + 0.8 * v / peak).collect();
+        let x: Vec<f64> = band_limited(&mut rng, n, dt, 5.0).iter().map(|v| 1.0 + 0.8 * v).collect();
         let db = crate::numerics::derivative::gradient(&x, dt);
         let eps = 0.1 * crate::numerics::stats::rms(&db);
         let x_min = crate::numerics::stats::min_max(&x).0;
         let term: Vec<f64> = x.iter().zip(&db).map(|(x, d)| (x - x_min) * 0.5 * (1.0 + (d / eps).tanh())).collect();
         let m = bouc_wen_truth(&x, dt);
         let (lo, hi) = crate::numerics::stats::min_max(&m);
-        let t_mean = crate::numerics::stats::mean(&term);
-        let size = crate::numerics::stats::rms(&term.iter().map(|t| t - t_mean).collect::<Vec<_>>());
-        let k = 0.04 * (hi - lo) / size;
+        let k = 0.04 * (hi - lo) / crate::numerics::stats::std(&term);
         let y: Vec<f64> = m.iter().zip(&term).map(|(m, t)| m + k * t).collect();
         let d = run(&with_noise(x, &y, &mut rng));
         let top = d.findings.first().unwrap_or_else(|| panic!("no finding: {:#?}", d.candidates));
