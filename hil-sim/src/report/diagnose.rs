@@ -141,8 +141,18 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
                 format!("{:.1}", c.bic_gain),
                 format!("{:.2} → {:.2}", 100.0 * c.heldout_r_rmse_before, 100.0 * c.heldout_r_rmse_after),
                 format!("{:.1}", c.test.t),
-                c.replication
-                    .map(|r| {
+                c.acting
+                    .map(|a| {
+                        format!(
+                            "tail sees {:.0} %; {:.2}–{:.2} s held out, interleaved: {:.0} % lower{}",
+                            100.0 * a.tail_share,
+                            a.from_s,
+                            a.to_s,
+                            100.0 * a.test.gain,
+                            if a.passed { " (passed)" } else { "" }
+                        )
+                    })
+                    .or(c.replication.map(|r| {
                         let p = if r.both.p_rank < 1e-4 {
                             "< 0.0001".to_owned()
                         } else {
@@ -153,7 +163,7 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
                             100.0 * r.head.gain,
                             if r.passed { " (passed)" } else { "" }
                         )
-                    })
+                    }))
                     .unwrap_or_default(),
                 c.lag_or_delay
                     .map(|m| {
@@ -168,15 +178,19 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
             ]
         })
         .collect();
-    rep.paragraph(
+    rep.paragraph(&format!(
         "Every candidate tested, by round, by BIC gain (kept: of those that pass the held-out block test, the one with \
          the lowest held-out error; not possible: fitted values no physical cause has, never kept). Reversed split: a \
          candidate the held-out tail left undecided, or close to another effect's, refitted with the first part of the \
          recording held out instead; its gain there and the signed-rank p \
-         over the blocks of both held-out parts. Lag and delay together: a field lag and a delay of the torque close \
+         over the blocks of both held-out parts. When a round keeps nothing, a candidate the tail barely excites (it \
+         changes the tail's prediction by less than {:.0} % of what it changes over the training part) is refitted \
+         with the stretch where it acts most held out instead, in two interleaved halves: its share on the tail and \
+         its gain on that stretch. Lag and delay together: a field lag and a delay of the torque close \
          on the held-out tail, the input given a share of the delay with the lag tuned on top; the share where the \
          training error is least names the effect (below half the lag, above it the delay):",
-    );
+        100.0 * crate::ident::diagnose::acting::QUIET_TAIL
+    ));
     let headers = [
         "round",
         "effect",
@@ -184,7 +198,7 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
         "BIC gain",
         "held-out R-RMSE (%)",
         "t-statistic",
-        "reversed split",
+        "second split",
         "lag and delay together",
         "kept or why not",
     ];
@@ -314,10 +328,12 @@ mod tests {
             heldout_r_rmse_after: 0.0235,
             test,
             change_of_noise: 13.5,
+            tail_share: 1.0,
             kept: false,
             impossible: Some("a loop narrowing as the input grows (delta = -1.2)".into()),
             replication: None,
             lag_or_delay: None,
+            acting: None,
         };
         assert_eq!(outcome(&c), "not possible: a loop narrowing as the input grows (delta = -1.2)");
         c.impossible = None;

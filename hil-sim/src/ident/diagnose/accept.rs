@@ -6,7 +6,10 @@
 //! residual's noise floor resolves and is physically possible ([`super::physical`]) is
 //! kept; every candidate is recorded as tested. One that meets all of it but the block
 //! test, and would predict the tail best, is given the reversed split ([`super::replicate`]).
+//! When none is kept, one the tail barely excites is given the split where it acts
+//! ([`super::acting`]).
 
+use super::acting::{self, Acting};
 use super::augment::{Fitted, Problem};
 use super::candidates::Candidate;
 use super::diagnosis::Tested;
@@ -36,6 +39,8 @@ pub struct Accepted {
     pub replication: Option<Replication>,
     /// The field lag and the delay given together, when that settled a tie between them.
     pub lag_or_delay: Option<Mixture>,
+    /// The split where it acts, when the tail barely excited it.
+    pub acting: Option<Acting>,
 }
 
 /// A round's outcome: every candidate as tested and the one kept, if any.
@@ -86,12 +91,12 @@ impl Judge<'_> {
             let resolvable = change_of_noise >= significance::MIN_TERM_OF_NOISE;
             let impossible =
                 super::physical::impossible(c, f, reference.terms.len(), s.value, self.dt, &prob.data.input);
-            let otherwise = impossible.is_none()
-                && s.bic_gain > 0.0
-                && f.train_mse < reference.train_mse
+            let fits = impossible.is_none() && s.bic_gain > 0.0 && f.train_mse < reference.train_mse && resolvable;
+            let tail_share = acting::rms_change(&f.pred, &reference.pred, self.held)
+                / acting::rms_change(&f.pred, &reference.pred, &prob.train).max(1e-300);
+            let otherwise = fits
                 && test.gain >= significance::MIN_FINDING_GAIN
-                && before.r_rmse - after.r_rmse >= significance::MIN_FINDING_DROP
-                && resolvable;
+                && before.r_rmse - after.r_rmse >= significance::MIN_FINDING_DROP;
             tested.push(Tested {
                 round,
                 effect: c.effect.to_owned(),
@@ -102,12 +107,15 @@ impl Judge<'_> {
                 heldout_r_rmse_after: after.r_rmse,
                 test,
                 change_of_noise,
+                tail_share,
                 kept: false,
                 impossible,
                 replication: None,
                 lag_or_delay: None,
+                acting: None,
             });
-            judged.push(Judged { otherwise, significant: test.significant, scored: s, test, after });
+            let quiet = fits && tail_share < acting::QUIET_TAIL;
+            judged.push(Judged { otherwise, significant: test.significant, quiet, tail_share, scored: s, test, after });
         }
         let reversed = Reversed::new(prob, reference);
         let replicate = |k: usize| {
@@ -120,12 +128,18 @@ impl Judge<'_> {
             let (l, d) = (&judged[lag].scored, &judged[delay].scored);
             lag_or_delay::profile(prob, reference, (&cands[l.index], l), (&cands[d.index], d))
         };
-        let best = choose(&judged, &mut tested, Ties { replicate, mixture, effect });
+        let best = choose(&judged, &mut tested, Ties { replicate, mixture, effect }).or_else(|| {
+            let act = |k: usize| {
+                let j = &judged[k];
+                acting::acting(prob, reference, &cands[j.scored.index], &j.scored, j.tail_share)
+            };
+            where_it_acts(&judged, &mut tested, act)
+        });
         let accepted = best.map(|k| {
             tested[k].kept = true;
-            let (replication, lag_or_delay) = (tested[k].replication, tested[k].lag_or_delay);
+            let (replication, lag_or_delay, acting) = (tested[k].replication, tested[k].lag_or_delay, tested[k].acting);
             let Judged { scored, test, after, .. } = judged.swap_remove(k);
-            Accepted { scored, test, after, replication, lag_or_delay }
+            Accepted { scored, test, after, replication, lag_or_delay, acting }
         });
         Verdict { before, tested, accepted }
     }
@@ -136,6 +150,9 @@ impl Judge<'_> {
 struct Judged {
     otherwise: bool,
     significant: bool,
+    /// Every condition but the tail's met, and the tail barely excites it ([`acting`]).
+    quiet: bool,
+    tail_share: f64,
     scored: Scored,
     test: Test,
     after: Metrics,
@@ -209,6 +226,20 @@ where
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .map(|(k, _)| k);
     Some(winner.unwrap_or(best))
+}
+
+/// When a round keeps nothing: of the candidates the tail barely excites, the first (by
+/// training gain) that passes on the split where it acts (`act`, recorded in `tested`).
+fn where_it_acts(judged: &[Judged], tested: &mut [Tested], act: impl Fn(usize) -> Option<Acting>) -> Option<usize> {
+    let mut quiet: Vec<usize> = (0..judged.len()).filter(|&k| judged[k].quiet).collect();
+    quiet.sort_by(|a, b| judged[*b].scored.bic_gain.total_cmp(&judged[*a].scored.bic_gain));
+    for k in quiet.into_iter().take(acting::MAX_TRIED) {
+        tested[k].acting = act(k);
+        if tested[k].acting.is_some_and(|a| a.passed) {
+            return Some(k);
+        }
+    }
+    None
 }
 
 /// When the tie is a field lag against a delay of the torque and nothing else, the one the

@@ -221,6 +221,48 @@ pub fn reversed_rows(data: &Dataset) -> (Vec<usize>, Vec<usize>) {
     (train, held)
 }
 
+/// A split of the held-out rows and the rows that train on them.
+pub type Split = (Vec<usize>, Vec<usize>);
+
+/// The two interleaved splits where a term acts ([`super::acting`]): in the run where it
+/// fits, the stretch as long as that run's held-out tail over which `weight` (what the term
+/// changes in the prediction, per sample) has the most energy, from the models' start-up on
+/// ([`WARM_UP_S`]), is cut into ten pieces; the first split holds out the even pieces, the
+/// second the odd ones, and every other row of every run trains. The splits and the stretch's
+/// first and last sample; `None` when no run has room for it.
+pub fn interleaved_rows(data: &Dataset, weight: &[f64]) -> Option<([Split; 2], (usize, usize))> {
+    let inside = inside(data);
+    let mut energy = vec![0.0; weight.len() + 1];
+    for (i, w) in weight.iter().enumerate() {
+        let counted = inside(&i) && !data.flagged(i);
+        energy[i + 1] = energy[i] + if counted { w * w } else { 0.0 };
+    }
+    let pieces = super::significance::BLOCKS;
+    let mut best: Option<(f64, usize, usize)> = None;
+    for r in data.spans() {
+        let len = r.end - r.train_end;
+        let first = r.start + (WARM_UP_S / data.dt) as usize;
+        if len < 4 * pieces || first + len > r.end.min(weight.len()) {
+            continue;
+        }
+        for a in first..=r.end - len {
+            let e = energy[a + len] - energy[a];
+            if best.is_none_or(|(b, _, _)| e > b) {
+                best = Some((e, a, a + len));
+            }
+        }
+    }
+    let (_, a, b) = best?;
+    let piece = |i: usize| (a..b).contains(&i).then(|| (i - a) * pieces / (b - a));
+    let split = |parity: usize| -> Split {
+        let out = |i: &usize| piece(*i).is_some_and(|k| k % 2 == parity);
+        let held = (a..b).filter(|i| out(i) && inside(i) && !data.flagged(*i)).collect();
+        let train = (0..data.len()).filter(|i| !out(i) && inside(i) && data.enters_fit(*i)).collect();
+        (held, train)
+    };
+    Some(([split(0), split(1)], (a, b - 1)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -136,7 +136,9 @@ pub fn open_all<'a>(bases: &'a Bases, s: &Shared<'a, '_>) -> Result<Vec<Opening<
 /// The held-out RMSE of an opening without a finding, and with its first round's finding.
 fn errors(o: &Opening<'_>, judge: &Judge<'_>) -> (f64, Option<f64>) {
     match &o.first {
-        Some((_, v)) => (v.before.rmse, v.accepted.as_ref().map(|a| a.after.rmse)),
+        // A finding kept on the split where it acts ([`super::acting`]) has no say here: the
+        // bases are weighed on the tail.
+        Some((_, v)) => (v.before.rmse, v.accepted.as_ref().filter(|a| a.acting.is_none()).map(|a| a.after.rmse)),
         None => (judge.heldout(&o.current.pred).rmse, None),
     }
 }

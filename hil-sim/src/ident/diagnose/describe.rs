@@ -6,6 +6,7 @@
 
 use std::collections::BTreeMap;
 
+use super::acting::Acting;
 use super::augment::Fitted;
 use super::candidates::{Candidate, DIRECTION_SQUARED_TERM, DIRECTION_TERM, LOADING_TERM};
 use super::diagnosis::{Evidence, Finding, Tested};
@@ -35,6 +36,8 @@ pub struct Described<'a> {
     pub replication: Option<Replication>,
     /// The field lag and the delay given together, when that settled a tie between them.
     pub lag_or_delay: Option<Mixture>,
+    /// The split where it acts, when the tail barely excited it.
+    pub acting: Option<Acting>,
     pub bic_gain: f64,
     /// Span (peak to peak) of the output on the held-out rows.
     pub y_span: f64,
@@ -146,8 +149,9 @@ pub fn finding(d: &Described<'_>) -> Finding {
         })
         .unwrap_or_default();
     let both = d.lag_or_delay.map(|m| mixture_clause(&m, c.effect)).unwrap_or_default();
+    let acts = d.acting.map(|a| acting_clause(&a)).unwrap_or_default();
     let summary = format!(
-        "{}; {size}; held-out R-RMSE {:.2} % -> {:.2} % ({:.0} % lower){again}{both}{weak}{}",
+        "{}; {size}; held-out R-RMSE {:.2} % -> {:.2} % ({:.0} % lower){again}{both}{acts}{weak}{}",
         what(d),
         100.0 * d.before.r_rmse,
         100.0 * d.after.r_rmse,
@@ -169,12 +173,28 @@ pub fn finding(d: &Described<'_>) -> Finding {
             test: d.test,
             replication: d.replication,
             lag_or_delay: d.lag_or_delay,
+            acting: d.acting,
             term_rms,
             term_share_of_span: share,
             bic_gain: d.bic_gain,
         },
         runner_up: d.runner_up.clone(),
     }
+}
+
+/// Why and how a term the held-out tail barely excites was kept, in words.
+fn acting_clause(a: &Acting) -> String {
+    format!(
+        " (the held-out tail barely excites it: there it changes the prediction by {:.0} % of what it changes over \
+         the training part; refitted with {:.2}-{:.2} s held out instead in interleaved pieces, where it acts most, that \
+         stretch's R-RMSE is {:.2} % -> {:.2} %, {:.0} % lower)",
+        100.0 * a.tail_share,
+        a.from_s,
+        a.to_s,
+        100.0 * a.r_rmse_before,
+        100.0 * a.r_rmse_after,
+        100.0 * a.test.gain
+    )
 }
 
 /// How a tie between a field lag and a delay of the torque was settled, in words.

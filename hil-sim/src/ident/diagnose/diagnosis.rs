@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 
 use serde::Serialize;
 
+use super::acting::Acting;
 use super::candidates::AuxChannel;
 use super::lag_or_delay::Mixture;
 use super::locate::{Condition, Locate};
@@ -49,6 +50,9 @@ pub struct Evidence {
     /// The lag and the delay given together, when that told them apart.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lag_or_delay: Option<Mixture>,
+    /// The split where it acts, when the tail barely excited it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub acting: Option<Acting>,
     /// RMS of what the term changes in the prediction, output units, and as a share of the
     /// output's span.
     pub term_rms: f64,
@@ -73,6 +77,10 @@ pub struct Tested {
     /// RMS of what the term changes in the prediction, in units of the residual's noise
     /// floor (below [`super::significance::MIN_TERM_OF_NOISE`] the recording does not resolve it).
     pub change_of_noise: f64,
+    /// What the term changes in the held-out tail's prediction over what it changes in the
+    /// training part's (RMS ratio; below [`super::acting::QUIET_TAIL`] the tail barely
+    /// excites it).
+    pub tail_share: f64,
     pub kept: bool,
     /// Why its fitted values are physically impossible (then it is never kept).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -84,6 +92,9 @@ pub struct Tested {
     /// [`super::replicate::NEAR`] of each other ([`super::lag_or_delay`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lag_or_delay: Option<Mixture>,
+    /// The split where it acts, when the tail barely excited it ([`super::acting`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub acting: Option<Acting>,
 }
 
 /// The whole diagnosis.

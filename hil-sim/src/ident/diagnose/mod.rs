@@ -32,6 +32,7 @@
 //!    draws the plots.
 
 pub mod accept;
+pub mod acting;
 pub mod augment;
 pub mod base;
 pub mod candidates;
@@ -187,6 +188,7 @@ fn diagnose_at_rate(
             test: kept.test,
             replication: kept.replication,
             lag_or_delay: kept.lag_or_delay,
+            acting: kept.acting,
             bic_gain: kept.scored.bic_gain,
             y_span,
             rate: &dx,
@@ -309,7 +311,7 @@ mod tests {
 
     /// The tests' true clutch, model-core's Bouc–Wen, fed `seen` (sampled every `dt` s) with
     /// its true rate (here the zero-phase one of the clean input).
-    fn bouc_wen_truth(seen: &[f64], dt: f64) -> Vec<f64> {
+    pub(super) fn bouc_wen_truth(seen: &[f64], dt: f64) -> Vec<f64> {
         let rates = crate::numerics::derivative::rates(seen, dt);
         let samples = crate::models::replay::samples_with_rates(seen, None, Some(&rates));
         let truth = [3.0, 2.0, 1.0, 1.0, 2.0, 0.4, 0.8, 0.0];
