@@ -151,11 +151,16 @@ pub fn finding(d: &Described<'_>) -> Finding {
     let both = d.lag_or_delay.map(|m| mixture_clause(&m, c.effect)).unwrap_or_default();
     let acts = d.acting.map(|a| acting_clause(&a)).unwrap_or_default();
     let summary = format!(
-        "{}; {size}; held-out R-RMSE {:.2} % -> {:.2} % ({:.0} % lower){again}{both}{acts}{weak}{}",
+        "{}; {size}; held-out R-RMSE {:.2} % -> {:.2} % ({}){again}{both}{acts}{weak}{}",
         what(d),
         100.0 * d.before.r_rmse,
         100.0 * d.after.r_rmse,
-        100.0 * d.test.gain,
+        // Only a term kept where it acts ([`super::acting`]) can predict the tail worse.
+        if d.test.gain >= 0.0 {
+            format!("{:.0} % lower", 100.0 * d.test.gain)
+        } else {
+            format!("{:.0} % higher on the tail", -100.0 * d.test.gain)
+        },
         caveats(data, &windows, d.boundaries)
     );
     Finding {
