@@ -3,7 +3,8 @@
 //! Gauss–Newton steps) and scored by the Bayesian information criterion on the training
 //! part, `BIC = n·ln(MSE) + k·ln(n)`; the [`POLISHED`] leading ones get more iterations.
 //! When a candidate's refit shows that the reference had stalled, the reference is refitted
-//! from there ([`reconverged`]) and every candidate refitted again on top of it.
+//! from there ([`reconverged`]) and every gain taken against it; when it lies far below the
+//! stalled one ([`RESCORE_SHIFT`]), every candidate is refitted again on top of it.
 
 use rayon::prelude::*;
 
@@ -54,11 +55,12 @@ pub fn reference(prob: &Problem<'_>, current: &Fitted) -> Option<Fitted> {
 /// Every candidate of `cands` not in `used`, refitted on top of `reference` and sorted by
 /// BIC gain, best first, with the reference they are judged against; `None` when the base
 /// model's Jacobian cannot be taken. When a candidate's refit found better base parameters
-/// ([`reconverged`]) by more than [`RESCORE_SHIFT`], every candidate is refitted again on top of
-/// the reference refitted from there and keeps the better of its two refits: judged against it from fits started at the
-/// stalled one only, they all looked worse (a Bingham recording under a sweep: all sixteen
-/// terms 500–18,000 below it, the concealed one among them). Should that reference stall
-/// too, the gains are taken against the better one without a third refit.
+/// ([`reconverged`]), the gains are taken against the reference refitted from there; when it
+/// lies more than [`RESCORE_SHIFT`] lower, every candidate is also refitted on top of it and
+/// keeps the better of its two refits: judged against it from fits started at the stalled one
+/// only, they all looked worse (a Bingham recording under a sweep: all sixteen terms
+/// 500–18,000 below it, the concealed one among them). Should that reference stall too, the
+/// gains are taken against the better one without a third refit.
 pub fn rank(
     prob: &Problem<'_>,
     cands: &[Candidate],
