@@ -152,18 +152,20 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
                             if a.passed { " (passed)" } else { "" }
                         )
                     })
-                    .or(c.replication.map(|r| {
-                        let p = if r.both.p_rank < 1e-4 {
-                            "< 0.0001".to_owned()
-                        } else {
-                            format!("= {:.4}", r.both.p_rank)
-                        };
-                        format!(
-                            "head {:.0} % lower; both p {p}{}",
-                            100.0 * r.head.gain,
-                            if r.passed { " (passed)" } else { "" }
-                        )
-                    }))
+                    .or_else(|| {
+                        c.replication.map(|r| {
+                            let p = if r.both.p_rank < 1e-4 {
+                                "< 0.0001".to_owned()
+                            } else {
+                                format!("= {:.4}", r.both.p_rank)
+                            };
+                            format!(
+                                "head {:.0} % lower; both p {p}{}",
+                                100.0 * r.head.gain,
+                                if r.passed { " (passed)" } else { "" }
+                            )
+                        })
+                    })
                     .unwrap_or_default(),
                 c.lag_or_delay
                     .map(|m| {

@@ -84,16 +84,12 @@ impl Judge<'_> {
             let test = significance::test(self.y, &reference.pred, &f.pred, self.held);
             let after = self.heldout(&f.pred);
             // What the term changes in the prediction must be resolvable above the noise.
-            let change = (self.rows.iter().map(|&i| (f.pred[i] - reference.pred[i]).powi(2)).sum::<f64>()
-                / self.rows.len().max(1) as f64)
-                .sqrt();
-            let change_of_noise = change / self.noise_rms.max(1e-300);
+            let change_of_noise = acting::rms_change(&f.pred, &reference.pred, self.rows) / self.noise_rms.max(1e-300);
             let resolvable = change_of_noise >= significance::MIN_TERM_OF_NOISE;
             let impossible =
                 super::physical::impossible(c, f, reference.terms.len(), s.value, self.dt, &prob.data.input);
             let fits = impossible.is_none() && s.bic_gain > 0.0 && f.train_mse < reference.train_mse && resolvable;
-            let tail_share = acting::rms_change(&f.pred, &reference.pred, self.held)
-                / acting::rms_change(&f.pred, &reference.pred, &prob.train).max(1e-300);
+            let tail_share = acting::tail_share(&f.pred, &reference.pred, self.held, &prob.train);
             let otherwise = fits
                 && test.gain >= significance::MIN_FINDING_GAIN
                 && before.r_rmse - after.r_rmse >= significance::MIN_FINDING_DROP;

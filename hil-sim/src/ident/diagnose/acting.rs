@@ -60,6 +60,12 @@ pub fn rms_change(a: &[f64], b: &[f64], rows: &[usize]) -> f64 {
     (rows.iter().map(|&i| (a[i] - b[i]).powi(2)).sum::<f64>() / rows.len().max(1) as f64).sqrt()
 }
 
+/// What the prediction `pred` changes from `reference` on the `held` rows over what it
+/// changes on the `train` rows (RMS ratio).
+pub fn tail_share(pred: &[f64], reference: &[f64], held: &[usize], train: &[usize]) -> f64 {
+    rms_change(pred, reference, held) / rms_change(pred, reference, train).max(1e-300)
+}
+
 /// Candidate `c` (scored `s`) against `reference` on the interleaved splits of `prob`'s
 /// recording where it acts; `None` when there is no room for them or a refit diverges.
 pub fn acting(prob: &Problem<'_>, reference: &Fitted, c: &Candidate, s: &Scored, tail_share: f64) -> Option<Acting> {
@@ -109,7 +115,7 @@ pub fn acting(prob: &Problem<'_>, reference: &Fitted, c: &Candidate, s: &Scored,
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ident::diagnose::tests::{bouc_wen_truth, round_one, with_noise};
+    use crate::ident::diagnose::tests::{bouc_wen_plus, bouc_wen_truth, round_one, with_noise};
     use rand::SeedableRng;
 
     /// 12 s at 1 kHz of a logarithmic sweep 0.5 → 12 Hz and back down (the bench's sweep):
@@ -134,9 +140,8 @@ mod tests {
         round_one(data, |prob, cands, reference, ranked| {
             let k = cands.iter().position(|c| c.label.contains("rate³")).unwrap();
             let s = ranked.iter().find(|s| s.index == k).unwrap();
-            let (train, held) = (&prob.train, crate::ident::diagnose::base::rows(data).1);
-            let share =
-                rms_change(&s.fitted.pred, &reference.pred, &held) / rms_change(&s.fitted.pred, &reference.pred, train);
+            let held = crate::ident::diagnose::base::rows(data).1;
+            let share = tail_share(&s.fitted.pred, &reference.pred, &held, &prob.train);
             acting(prob, reference, &cands[k], s, share)
         })
     }
@@ -147,10 +152,8 @@ mod tests {
         let x = sweep();
         let db = crate::numerics::derivative::gradient(&x, 1e-3);
         let cubed: Vec<f64> = db.iter().map(|d| d * d * d).collect();
+        let y = bouc_wen_plus(&x, 1e-3, &cubed, 0.015, crate::numerics::stats::rms);
         let m = bouc_wen_truth(&x, 1e-3);
-        let (lo, hi) = crate::numerics::stats::min_max(&m);
-        let c = 0.015 * (hi - lo) / crate::numerics::stats::rms(&cubed);
-        let y: Vec<f64> = m.iter().zip(&cubed).map(|(m, t)| m + c * t).collect();
         let real = rate_cubed_acting(&with_noise(x.clone(), &y, &mut rand::rngs::StdRng::seed_from_u64(17))).unwrap();
         assert!(real.passed && real.test.gain > 0.3, "{real:?}");
         assert!(real.from_s < 6.0 && real.to_s > 6.0, "the sweep's top is at 6 s: {real:?}");

@@ -319,6 +319,15 @@ mod tests {
         out.y.iter().map(|v| f64::from(*v)).collect()
     }
 
+    /// The tests' Bouc–Wen clutch fed `x` (sampled every `dt` s) with `term` added, scaled so
+    /// that its `size` is `share` of the clutch's torque span.
+    pub(super) fn bouc_wen_plus(x: &[f64], dt: f64, term: &[f64], share: f64, size: fn(&[f64]) -> f64) -> Vec<f64> {
+        let m = bouc_wen_truth(x, dt);
+        let (lo, hi) = crate::numerics::stats::min_max(&m);
+        let k = share * (hi - lo) / size(term);
+        m.iter().zip(term).map(|(m, t)| m + k * t).collect()
+    }
+
     /// `n` samples of uniform white noise from `rng` through four zero-phase first-order
     /// low-passes at `hz` (sampled every `dt` s), scaled to a peak of 1.
     fn band_limited(rng: &mut impl Rng, n: usize, dt: f64, hz: f64) -> Vec<f64> {
@@ -461,10 +470,7 @@ mod tests {
         let db = crate::numerics::derivative::gradient(&x, dt);
         let f_bar = crate::numerics::stats::mean(&f_mem);
         let term: Vec<f64> = f_mem.iter().zip(&db).map(|(f, d)| (f / f_bar - 1.0) * d).collect();
-        let m = bouc_wen_truth(&x, dt);
-        let (lo, hi) = crate::numerics::stats::min_max(&m);
-        let k = 0.04 * (hi - lo) / crate::numerics::stats::rms(&term);
-        let y: Vec<f64> = m.iter().zip(&term).map(|(m, t)| m + k * t).collect();
+        let y = bouc_wen_plus(&x, dt, &term, 0.04, crate::numerics::stats::rms);
         let d = run(&with_noise(x, &y, &mut rand::rngs::StdRng::seed_from_u64(11)));
         let top = d.findings.first().unwrap_or_else(|| panic!("no finding: {:#?}", d.candidates));
         assert_eq!(top.effect, "rate_dependence", "{:#?}", d.candidates);
@@ -489,10 +495,7 @@ mod tests {
         let eps = 0.1 * crate::numerics::stats::rms(&db);
         let x_min = crate::numerics::stats::min_max(&x).0;
         let term: Vec<f64> = x.iter().zip(&db).map(|(x, d)| (x - x_min) * 0.5 * (1.0 + (d / eps).tanh())).collect();
-        let m = bouc_wen_truth(&x, dt);
-        let (lo, hi) = crate::numerics::stats::min_max(&m);
-        let k = 0.04 * (hi - lo) / crate::numerics::stats::std(&term);
-        let y: Vec<f64> = m.iter().zip(&term).map(|(m, t)| m + k * t).collect();
+        let y = bouc_wen_plus(&x, dt, &term, 0.04, crate::numerics::stats::std);
         let d = run(&with_noise(x, &y, &mut rng));
         let top = d.findings.first().unwrap_or_else(|| panic!("no finding: {:#?}", d.candidates));
         assert_eq!(top.effect, "asymmetry", "{:#?}", d.candidates);

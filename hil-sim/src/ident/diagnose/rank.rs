@@ -67,37 +67,30 @@ pub fn rank(
     reference: &Fitted,
     used: &[usize],
 ) -> Option<(Fitted, Vec<Scored>)> {
+    let n = prob.train.len();
     let mut scored = scored_on(prob, cands, reference, used)?;
-    let Some(better) = reconverged(prob, reference, &scored) else { return Some((reference.clone(), scored)) };
-    let bic_better = bic(prob.train.len(), &better);
-    // Each candidate keeps whichever of its two refits fits the training part better.
-    let again = if bic(prob.train.len(), reference) - bic_better > RESCORE_SHIFT {
-        scored_on(prob, cands, &better, used).unwrap_or_default()
-    } else {
-        Vec::new()
-    };
-    for again in again {
-        if let Some(s) =
-            scored.iter_mut().find(|s| s.index == again.index && again.fitted.train_mse < s.fitted.train_mse)
-        {
-            *s = again;
+    let Some(mut better) = reconverged(prob, reference, &scored) else { return Some((reference.clone(), scored)) };
+    if bic(n, reference) - bic(n, &better) > RESCORE_SHIFT {
+        // Each candidate keeps whichever of its two refits fits the training part better.
+        for again in scored_on(prob, cands, &better, used).unwrap_or_default() {
+            if let Some(s) =
+                scored.iter_mut().find(|s| s.index == again.index && again.fitted.train_mse < s.fitted.train_mse)
+            {
+                *s = again;
+            }
+        }
+        // Only new refits can show `better` stalled in turn: without them, the candidates' θ are
+        // the ones it was already refitted from the best of.
+        if let Some(b) = reconverged(prob, &better, &scored) {
+            better = b;
         }
     }
+    let bic_better = bic(n, &better);
     for s in &mut scored {
-        s.bic_gain = bic_better - bic(prob.train.len(), &s.fitted);
+        s.bic_gain = bic_better - bic(n, &s.fitted);
     }
     scored.sort_by(|a, b| b.bic_gain.total_cmp(&a.bic_gain));
-    let reference = better;
-    match reconverged(prob, &reference, &scored) {
-        Some(better) => {
-            let shift = bic(prob.train.len(), &reference) - bic(prob.train.len(), &better);
-            for s in &mut scored {
-                s.bic_gain -= shift;
-            }
-            Some((better, scored))
-        }
-        None => Some((reference, scored)),
-    }
+    Some((better, scored))
 }
 
 /// Every candidate of `cands` not in `used`, refitted on top of `reference` and sorted by
