@@ -98,13 +98,17 @@ fn centred(v: &[f64]) -> Vec<f64> {
 /// The local excitation frequency relative to its mean, less 1: `f_loc/f̄ − 1`, with
 /// `2π·f_loc` the RMS rate over the RMS level about the local mean, each a causal
 /// first-order average over `window_s` (the fluid's damping can follow the excitation only
-/// from what it has seen). 0 where the input rests.
-fn local_frequency(x: &[f64], dx: &[f64], dt: f64, window_s: f64) -> Vec<f64> {
+/// from what it has seen). 0 where the input rests. `2π·f_loc` is held below `cap` (rad/s),
+/// the band the rate carries: where both averages are near zero (the first samples of a
+/// record that starts moving, with the level's average started at the first sample) their
+/// ratio is otherwise ~10¹⁴⁶, sets `f̄`, and leaves the term ≈ `−ẋ` everywhere else.
+fn local_frequency(x: &[f64], dx: &[f64], dt: f64, window_s: f64, cap: f64) -> Vec<f64> {
     let average = |v: &[f64]| lowpass(v, window_s, dt);
     let level = average(x);
     let dev: Vec<f64> = x.iter().zip(&level).map(|(x, m)| (x - m) * (x - m)).collect();
     let (p_x, p_dx) = (average(&dev), average(&dx.iter().map(|d| d * d).collect::<Vec<f64>>()));
-    let f: Vec<f64> = p_x.iter().zip(&p_dx).map(|(px, pd)| if *px > 0.0 { (pd / px).sqrt() } else { 0.0 }).collect();
+    let f: Vec<f64> =
+        p_x.iter().zip(&p_dx).map(|(px, pd)| if *px > 0.0 { (pd / px).sqrt().min(cap) } else { 0.0 }).collect();
     let mean_f = mean(&f);
     if !(mean_f > 0.0 && mean_f.is_finite()) {
         return vec![0.0; x.len()];
@@ -120,6 +124,7 @@ const FREQUENCY_WINDOWS_S: (f64, f64, usize) = (0.1, 3.0, 8);
 /// averaging time the grid value.
 fn frequency_damping(s: &InputStats) -> Candidate {
     let (x, dx, dt) = (s.x.clone(), s.dx.clone(), s.dt);
+    let cap = 2.0 * std::f64::consts::PI * s.rate_band_hz;
     let (lo, hi, n) = FREQUENCY_WINDOWS_S;
     Candidate {
         effect: "rate_dependence",
@@ -127,7 +132,7 @@ fn frequency_damping(s: &InputStats) -> Candidate {
         grid_name: Some("window_s".into()),
         grid: log_grid(lo, hi, n),
         build: Box::new(move |w| {
-            let term = local_frequency(&x, &dx, dt, w).iter().zip(&dx).map(|(f, d)| f * d).collect();
+            let term = local_frequency(&x, &dx, dt, w, cap).iter().zip(&dx).map(|(f, d)| f * d).collect();
             Piece { transform: None, terms: vec![Term::additive("c_freq", term)] }
         }),
         channel: None,
@@ -245,10 +250,12 @@ struct InputStats {
     x_mean: f64,
     /// Standard deviation of the rate.
     dx_std: f64,
+    /// The band the rate carries (Hz): it was smoothed there.
+    rate_band_hz: f64,
 }
 
 impl InputStats {
-    fn of(data: &Dataset) -> Self {
+    fn of(data: &Dataset, rate_band_hz: f64) -> Self {
         let x = data.input.clone();
         let (dx, ddx) = rates(data);
         let x_max = x.iter().fold(0.0f64, |a, v| a.max(v.abs())).max(1e-300);
@@ -258,7 +265,7 @@ impl InputStats {
         };
         let x_mean = mean(&x);
         let dx_std = std(&dx).max(1e-300);
-        Self { dt: data.dt, x, dx, ddx, x_max, x_span, x_mean, dx_std }
+        Self { dt: data.dt, x, dx, ddx, x_max, x_span, x_mean, dx_std, rate_band_hz }
     }
 }
 
@@ -282,9 +289,9 @@ fn additive(
 
 /// Every candidate for this recording; `input_is_field`: the input is a magnetic field
 /// (unit T), which has no mass, so `m·ẍ` of it is no inertia (a clutch's inertia shows
-/// through a speed channel).
-pub fn all(data: &Dataset, aux: &[AuxChannel], input_is_field: bool) -> Vec<Candidate> {
-    let s = InputStats::of(data);
+/// through a speed channel). `rate_band_hz`: where the input's rate was smoothed.
+pub fn all(data: &Dataset, aux: &[AuxChannel], input_is_field: bool, rate_band_hz: f64) -> Vec<Candidate> {
+    let s = InputStats::of(data, rate_band_hz);
     let mut out = input_transforms(&s);
     out.push(yield_saturation(data));
     out.extend(
@@ -570,5 +577,25 @@ mod tests {
         // ... the correlation beyond the input can.
         assert!(acceleration_corr(&current, &x, &ddx).abs() < 0.3, "{}", acceleration_corr(&current, &x, &ddx));
         assert!(acceleration_corr(&accel, &x, &ddx).abs() > 0.6, "{}", acceleration_corr(&accel, &x, &ddx));
+    }
+
+    /// A record that starts moving (a sine from phase 0, at 4 Hz then 8 Hz): the local
+    /// frequency's first samples divide the rate's power by a level power near zero; held
+    /// below the rate's band, they leave the mean, and so the two halves, where they are.
+    #[test]
+    fn a_record_starting_at_full_rate_keeps_its_local_frequencies() {
+        let dt = 5e-4;
+        let (mut x, mut dx, mut phase) = (Vec::new(), Vec::new(), 0.0f64);
+        for k in 0..16_000 {
+            let w = std::f64::consts::TAU * if k < 8_000 { 4.0 } else { 8.0 };
+            x.push(phase.sin());
+            dx.push(w * phase.cos());
+            phase += w * dt;
+        }
+        let f = local_frequency(&x, &dx, dt, 0.5, std::f64::consts::TAU * 60.0);
+        let avg = |a: usize, b: usize| f[a..b].iter().sum::<f64>() / (b - a) as f64;
+        let (slow, fast) = (avg(3_000, 8_000), avg(11_000, 16_000));
+        // f̄ ≈ 6 Hz: 4/6 − 1 and 8/6 − 1, whatever the first samples were.
+        assert!((slow + 1.0 / 3.0).abs() < 0.1 && (fast - 1.0 / 3.0).abs() < 0.1, "{slow} {fast}");
     }
 }

@@ -126,7 +126,7 @@ fn diagnose_at_rate(
     let (dx, _) = candidates::rates(data);
     let aux_refs: Vec<(&str, &[f64])> =
         channels.iter().filter(|c| c.role != Role::Unused).map(|c| (c.name.as_str(), c.values.as_slice())).collect();
-    let cands = candidates::all(data, &channels, unit_of(names.0) == Some("T"));
+    let cands = candidates::all(data, &channels, unit_of(names.0) == Some("T"), rate_cutoff_hz);
     let judge0 = Judge { y: &data.output, held: &held, rows: &all_rows, noise_rms: 0.0, dt: data.dt };
     progress.advance(1);
     progress.message("round 1: naming");
@@ -379,7 +379,7 @@ mod tests {
         };
         let current = prob.refit(&[], &[], None, &b.fit.flat, 8).unwrap().0;
         let reference = rank::reference(&prob, &current).unwrap();
-        let cands = candidates::all(data, &candidates::classify(data, vec![], None), false);
+        let cands = candidates::all(data, &candidates::classify(data, vec![], None), false, prob.rate_cutoff_hz);
         let (reference, ranked) = rank::rank(&prob, &cands, &reference, &[]).unwrap();
         f(&prob, &cands, &reference, &ranked)
     }

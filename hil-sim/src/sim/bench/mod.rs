@@ -112,6 +112,11 @@ pub enum Set {
     /// A twenty-first held-out range, first run for the same report as fresh19, with the same
     /// method.
     Fresh20,
+    /// A twenty-second held-out range, first run for the report of 2026-11-28 (third).
+    Fresh21,
+    /// A twenty-third held-out range, first run for the same report as fresh21, with the same
+    /// method.
+    Fresh22,
 }
 
 impl Set {
@@ -139,6 +144,8 @@ impl Set {
         ("fresh18", Set::Fresh18),
         ("fresh19", Set::Fresh19),
         ("fresh20", Set::Fresh20),
+        ("fresh21", Set::Fresh21),
+        ("fresh22", Set::Fresh22),
     ];
 
     /// The seed of case `k` of this set.
@@ -166,6 +173,8 @@ impl Set {
             Set::Fresh18 => 110_000_000 + 79 * k,
             Set::Fresh19 => 118_000_000 + 83 * k,
             Set::Fresh20 => 127_000_000 + 89 * k,
+            Set::Fresh21 => 136_000_000 + 97 * k,
+            Set::Fresh22 => 146_000_000 + 101 * k,
         }
     }
 }
