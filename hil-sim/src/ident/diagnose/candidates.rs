@@ -99,9 +99,10 @@ fn centred(v: &[f64]) -> Vec<f64> {
 /// `2π·f_loc` the RMS rate over the RMS level about the local mean, each a causal
 /// first-order average over `window_s` (the fluid's damping can follow the excitation only
 /// from what it has seen). 0 where the input rests. `2π·f_loc` is held below `cap` (rad/s),
-/// the band the rate carries: where both averages are near zero (the first samples of a
-/// record that starts moving, with the level's average started at the first sample) their
-/// ratio is otherwise ~10¹⁴⁶, sets `f̄`, and leaves the term ≈ `−ẋ` everywhere else.
+/// the band the rate carries: where the level's power is near zero and the rate's is not
+/// (the first samples of a record that starts moving: the averages start at the first
+/// sample) their ratio is unbounded (~10¹⁴⁶ on a bench recording), sets `f̄`, and leaves the
+/// term ≈ `−ẋ` everywhere else.
 fn local_frequency(x: &[f64], dx: &[f64], dt: f64, window_s: f64, cap: f64) -> Vec<f64> {
     let average = |v: &[f64]| lowpass(v, window_s, dt);
     let level = average(x);
@@ -250,7 +251,7 @@ struct InputStats {
     x_mean: f64,
     /// Standard deviation of the rate.
     dx_std: f64,
-    /// The band the rate carries (Hz): it was smoothed there.
+    /// The band the rate carries (Hz): where it was smoothed, else the estimator's top.
     rate_band_hz: f64,
 }
 
