@@ -99,10 +99,8 @@ fn centred(v: &[f64]) -> Vec<f64> {
 /// `2π·f_loc` the RMS rate over the RMS level about the local mean, each a causal
 /// first-order average over `window_s` (the fluid's damping can follow the excitation only
 /// from what it has seen). 0 where the input rests. `2π·f_loc` is held below `cap` (rad/s),
-/// the band the rate carries: where the level's power is near zero and the rate's is not
-/// (the first samples of a record that starts moving: the averages start at the first
-/// sample) their ratio is unbounded (~10¹⁴⁶ on a bench recording), sets `f̄`, and leaves the
-/// term ≈ `−ẋ` everywhere else.
+/// the rate's band: at the first samples of a record starting in motion the level's power is
+/// ~0 and the rate's is not, and the unbounded ratio (~10¹⁴⁶ on a bench recording) set `f̄`.
 fn local_frequency(x: &[f64], dx: &[f64], dt: f64, window_s: f64, cap: f64) -> Vec<f64> {
     let average = |v: &[f64]| lowpass(v, window_s, dt);
     let level = average(x);
@@ -580,9 +578,8 @@ mod tests {
         assert!(acceleration_corr(&accel, &x, &ddx).abs() > 0.6, "{}", acceleration_corr(&accel, &x, &ddx));
     }
 
-    /// A record that starts moving (a sine from phase 0, at 4 Hz then 8 Hz): the local
-    /// frequency's first samples divide the rate's power by a level power near zero; held
-    /// below the rate's band, they leave the mean, and so the two halves, where they are.
+    /// A record starting in motion (a sine from phase 0, 4 Hz then 8 Hz): its first samples,
+    /// held below the rate's band, leave the mean, and so the two halves, where they are.
     #[test]
     fn a_record_starting_at_full_rate_keeps_its_local_frequencies() {
         let dt = 5e-4;
