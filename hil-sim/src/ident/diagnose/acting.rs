@@ -76,14 +76,7 @@ pub fn acting(prob: &Problem<'_>, reference: &Fitted, c: &Candidate, s: &Scored,
     let y = &data.output;
     let (mut blocks, mut fitted_better, mut pairs) = (Vec::new(), true, (Vec::new(), Vec::new(), Vec::new()));
     for (held, train) in splits {
-        let split = Problem {
-            data,
-            sim: prob.sim,
-            spec: prob.spec,
-            rate: prob.rate,
-            train,
-            rate_cutoff_hz: prob.rate_cutoff_hz,
-        };
+        let split = prob.on_rows(train);
         let (before, _) = split.refit(&reference.transforms, &reference.terms, None, &reference.theta, iterations)?;
         let start = [(s.value, Some(s.fitted.theta.clone()))];
         let (after, _) = refit_candidate(&split, c, &before, &start, iterations)?;

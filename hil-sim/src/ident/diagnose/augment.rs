@@ -323,7 +323,13 @@ impl Simulator for AugSim<'_, '_> {
     }
 }
 
-impl Problem<'_> {
+impl<'a> Problem<'a> {
+    /// The same problem trained on `train` instead (another split of the recording).
+    pub fn on_rows(&self, train: Vec<usize>) -> Problem<'a> {
+        let (data, sim, spec, rate, rate_cutoff_hz) = (self.data, self.sim, self.spec, self.rate, self.rate_cutoff_hz);
+        Problem { data, sim, spec, rate, train, rate_cutoff_hz }
+    }
+
     /// The base model's output for `theta` fed the transformed input (`None` if it diverges).
     pub fn run(&self, theta: &[f64], transforms: &[Transform]) -> Option<Vec<f64>> {
         let kin = self.kin(transforms)?;

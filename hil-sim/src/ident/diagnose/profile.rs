@@ -25,14 +25,7 @@ const PROFILE_SAMPLES: usize = 12_000;
 /// grid), each with the θ its profile refit reached.
 pub fn starts(prob: &Problem<'_>, c: &Candidate, current: &Fitted) -> Vec<Start> {
     // The first PROFILE_SAMPLES of the training part rank the grid values.
-    let short = Problem {
-        data: prob.data,
-        sim: prob.sim,
-        spec: prob.spec,
-        rate: prob.rate,
-        train: prob.train.iter().copied().take_while(|&i| i < PROFILE_SAMPLES).collect(),
-        rate_cutoff_hz: prob.rate_cutoff_hz,
-    };
+    let short = prob.on_rows(prob.train.iter().copied().take_while(|&i| i < PROFILE_SAMPLES).collect());
     let prob = if short.train.len() >= 1000 { &short } else { prob };
     let profile: Vec<(f64, f64, Option<Vec<f64>>)> = continuation_chains(c, &prob.data.input, prob.data.dt)
         .par_iter()

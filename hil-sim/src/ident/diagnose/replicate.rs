@@ -58,15 +58,7 @@ impl<'p, 'a> Reversed<'p, 'a> {
     /// The reversed split of `prob`'s recording, for a round whose reference is `reference`.
     pub fn new(prob: &Problem<'a>, reference: &'p Fitted) -> Self {
         let (train, held) = reversed_rows(prob.data);
-        let prob = Problem {
-            data: prob.data,
-            sim: prob.sim,
-            spec: prob.spec,
-            rate: prob.rate,
-            train,
-            rate_cutoff_hz: prob.rate_cutoff_hz,
-        };
-        Self { prob, held, reference, refitted: OnceLock::new() }
+        Self { prob: prob.on_rows(train), held, reference, refitted: OnceLock::new() }
     }
 
     /// Candidate `c` (scored `s` on the tail, whose blocks were `tail`) refitted on the
