@@ -5,8 +5,7 @@
 //! Auxiliary channels are used only when the recording has them. Each is first classified
 //! from its data and its name ([`classify`]):
 //!
-//! - a copy of the input's rate (|corr(a, ẋ)| ≥ 0.9, e.g. the Dyke files' `V`): the model
-//!   already has the rate; not a cause;
+//! - a copy of the input's rate (|corr(a, ẋ)| ≥ 0.9, e.g. the Dyke files' `V`): not a cause;
 //! - a channel the input explains (R² ≥ [`FOLLOWS_R2`] of `a` on `x`, `x²`, `ẋ` and
 //!   `tanh(ẋ/ε)`, e.g. a coil current next to its field, with eddy lag and remanence):
 //!   what it could add is a function of the input, which the input's own candidates test
@@ -308,7 +307,9 @@ pub fn all(data: &Dataset, aux: &[AuxChannel], input_is_field: bool, rate_band_h
     out
 }
 
-/// Phase (a first-order lag, a two-pole lag, 1 sample to 50 ms, and a pure delay, ±30 ms) and amplitude (a
+/// Longest field lag tried (s): a large clutch's coil (L/R) or a slow fluid reaches a few hundred ms.
+const LAG_MAX_S: f64 = 0.3;
+/// Phase (a first-order and a two-pole lag, 1 sample to [`LAG_MAX_S`], and a pure delay, ±30 ms) and amplitude (a
 /// saturating map and a zero offset): transforms of the input the base model is fed.
 fn input_transforms(s: &InputStats) -> Vec<Candidate> {
     let dt = s.dt;
@@ -326,14 +327,14 @@ fn input_transforms(s: &InputStats) -> Vec<Candidate> {
             "field_lag",
             "first-order lag of the input",
             "tau_s",
-            log_grid(dt, (0.05f64).max(4.0 * dt), 14),
+            log_grid(dt, LAG_MAX_S.max(4.0 * dt), 20),
             |tau| Transform::Lag { tau_s: tau },
         ),
         transform(
             "field_lag",
             "two-pole lag of the input",
             "tau_s",
-            log_grid(2.0 * dt, (0.05f64).max(8.0 * dt), 14),
+            log_grid(2.0 * dt, LAG_MAX_S.max(8.0 * dt), 20),
             |tau| Transform::Lag2 { tau_s: tau },
         ),
         transform("transport_delay", "time shift between input and output", "delay_s", delays, |d| Transform::Delay {

@@ -400,6 +400,22 @@ mod tests {
     }
 
     #[test]
+    fn a_slow_field_lag_is_named_beyond_fifty_milliseconds() {
+        // A coil-dominated lag of 120 ms (a large clutch's L/R) under band-limited noise at
+        // 2 Hz, the bench's slowest excitation: searched only to 50 ms (until 2026-11-28), the
+        // lag sat at its edge, was impossible, and nothing was named.
+        let mut rng = rand::rngs::StdRng::seed_from_u64(17);
+        let (dt, n) = (1e-3, 12_000);
+        let x: Vec<f64> = band_limited(&mut rng, n, dt, 2.0).iter().map(|v| 0.8 * v).collect();
+        let y = bouc_wen_truth(&Transform::Lag { tau_s: 0.12 }.apply(&x, dt), dt);
+        let d = run(&with_noise(x, &y, &mut rng));
+        let top = d.findings.first().unwrap_or_else(|| panic!("no finding: {:#?}", d.candidates));
+        assert_eq!(top.effect, "field_lag", "{:#?}", d.candidates);
+        let tau = top.params["tau_s"];
+        assert!((0.09..=0.16).contains(&tau), "tau {tau}");
+    }
+
+    #[test]
     fn a_yield_stress_levelling_off_is_named_on_the_output_side() {
         // A unipolar field 0.2–1.8; the torque above its floor compressed by
         // u/√(1 + (u/T_s)²) with T_s = 1.5 spans (the RMS change is some 6 % of the span).

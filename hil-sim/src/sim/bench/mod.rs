@@ -117,6 +117,12 @@ pub enum Set {
     /// A twenty-third held-out range, first run for the same report as fresh21, with the same
     /// method.
     Fresh22,
+    /// A twenty-fourth held-out range, first run for the report of 2026-11-28 (fourth: field
+    /// lags searched to 300 ms).
+    Fresh23,
+    /// A twenty-fifth held-out range, first run for the same report as fresh23, with the same
+    /// method.
+    Fresh24,
 }
 
 impl Set {
@@ -146,6 +152,8 @@ impl Set {
         ("fresh20", Set::Fresh20),
         ("fresh21", Set::Fresh21),
         ("fresh22", Set::Fresh22),
+        ("fresh23", Set::Fresh23),
+        ("fresh24", Set::Fresh24),
     ];
 
     /// The seed of case `k` of this set.
@@ -175,6 +183,8 @@ impl Set {
             Set::Fresh20 => 127_000_000 + 89 * k,
             Set::Fresh21 => 136_000_000 + 97 * k,
             Set::Fresh22 => 146_000_000 + 101 * k,
+            Set::Fresh23 => 166_000_000 + 103 * k,
+            Set::Fresh24 => 178_000_000 + 107 * k,
         }
     }
 }
