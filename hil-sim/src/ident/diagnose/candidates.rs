@@ -307,7 +307,7 @@ pub fn all(data: &Dataset, aux: &[AuxChannel], input_is_field: bool, rate_band_h
     out
 }
 
-/// Longest field lag tried (s): a large clutch's coil (L/R) or a slow fluid reaches a few hundred ms.
+/// Longest field lag tried (s): eddy currents in thick discs, or a coil's L/R behind a current input, reach 0.1–0.2 s.
 const LAG_MAX_S: f64 = 0.3;
 /// Phase (a first-order and a two-pole lag, 1 sample to [`LAG_MAX_S`], and a pure delay, ±30 ms) and amplitude (a
 /// saturating map and a zero offset): transforms of the input the base model is fed.

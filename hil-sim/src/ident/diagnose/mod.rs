@@ -400,10 +400,10 @@ mod tests {
     }
 
     #[test]
-    fn a_slow_field_lag_is_named_beyond_fifty_milliseconds() {
-        // A coil-dominated lag of 120 ms (a large clutch's L/R) under band-limited noise at
-        // 2 Hz, the bench's slowest excitation: searched only to 50 ms (until 2026-11-28), the
-        // lag sat at its edge, was impossible, and nothing was named.
+    fn a_slow_field_lag_is_named_with_its_time_constant() {
+        // A 120 ms lag (eddy currents in thick discs, or a coil's L/R behind a current input)
+        // under band-limited noise at 2 Hz, the bench's slowest excitation: searched only to
+        // 50 ms (until 2026-11-28), the lag sat at its edge, was impossible, and nothing was named.
         let mut rng = rand::rngs::StdRng::seed_from_u64(17);
         let (dt, n) = (1e-3, 12_000);
         let x: Vec<f64> = band_limited(&mut rng, n, dt, 2.0).iter().map(|v| 0.8 * v).collect();
