@@ -12,7 +12,7 @@
 //! - [`bench_table`] (ignored, about 25 minutes): the full table, per effect and per
 //!   excitation: `BENCH_SET=heldout cargo test --release -p integration-tests --test
 //!   diagnose_concealed -- --ignored --nocapture` (`BENCH_SET=dev` for the development
-//!   seeds, `fresh` … `fresh24` for the second to twenty-fifth held-out ranges; `BENCH_N`,
+//!   seeds, `fresh` … `fresh26` for the second to twenty-seventh held-out ranges; `BENCH_N`,
 //!   `BENCH_NULL` for the number of effect and null cases, default 256 and 48;
 //!   `BENCH_MIN_FS`, `BENCH_MAX_FS` keep only the cases sampled within those rates, Hz;
 //!   `BENCH_SEEDS=a,b,…` only the cases with those seeds, `BENCH_EFFECTS=e,…` only those
@@ -220,8 +220,21 @@ fn blind_subset_of_heldout_seeds() {
     assert!(all >= 0.65, "{:.1} % named first\n{t}", 100.0 * all);
 }
 
+/// Two Bouc–Wen nulls under a sweep (fresh19 `126301743`, fresh23 `176302163`: development
+/// since their reports) on which LuGre with a sharp-knee saturation predicted the tail 22–28 %
+/// better than Bouc–Wen alone and was chosen as the base, naming the saturation: a switch of
+/// base needs its finding to gain 30 % (`contenders::MIN_SWITCH_GAIN`).
 #[test]
-#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh24|dev, BENCH_N, BENCH_NULL"]
+fn a_small_gain_on_another_base_is_no_finding_on_a_null() {
+    for (set, seed) in [(Set::Fresh19, 126_301_743), (Set::Fresh23, 176_302_163)] {
+        let c = cases(set, 200, 40).into_iter().find(|c| c.seed == seed).expect("the case");
+        let o = run(&c);
+        assert!(o.right(), "{}", line(&o));
+    }
+}
+
+#[test]
+#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh26|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
     let sets = Set::NAMED;
     let key = std::env::var("BENCH_SET").ok();

@@ -123,6 +123,12 @@ pub enum Set {
     /// A twenty-fifth held-out range, first run for the same report as fresh23, with the same
     /// method.
     Fresh24,
+    /// A twenty-sixth held-out range, first run for the report of 2026-11-28 (fifth: a switch of
+    /// base needs a 30 % gain).
+    Fresh25,
+    /// A twenty-seventh held-out range, first run for the same report as fresh25, with the same
+    /// method.
+    Fresh26,
 }
 
 impl Set {
@@ -154,6 +160,8 @@ impl Set {
         ("fresh22", Set::Fresh22),
         ("fresh23", Set::Fresh23),
         ("fresh24", Set::Fresh24),
+        ("fresh25", Set::Fresh25),
+        ("fresh26", Set::Fresh26),
     ];
 
     /// The seed of case `k` of this set.
@@ -185,6 +193,8 @@ impl Set {
             Set::Fresh22 => 146_000_000 + 101 * k,
             Set::Fresh23 => 166_000_000 + 103 * k,
             Set::Fresh24 => 178_000_000 + 107 * k,
+            Set::Fresh25 => 190_000_000 + 109 * k,
+            Set::Fresh26 => 202_000_000 + 113 * k,
         }
     }
 }
