@@ -7,8 +7,7 @@
 //! first round on its own ([`open`]), and [`choose`] keeps
 //! the base whose first round predicts the held-out part best: a base with a finding is
 //! chosen only when that prediction beats the best base without one by the paired block
-//! test ([`super::significance`]) and by [`MIN_SWITCH_GAIN`]; otherwise the best base without
-//! a finding is kept.
+//! test ([`super::significance`]); otherwise the best base without a finding is kept.
 //!
 //! On the development seeds of the blind bench: the true family plus the concealed term is
 //! close to exact, while a wrong family either misses the effect or needs it under another
@@ -160,19 +159,11 @@ pub fn choose(openings: &[Opening<'_>], judge: &Judge<'_>) -> usize {
         None => &openings[null].current.pred,
     };
     let pair_pred = openings[pair].first.as_ref().and_then(|(_, v)| v.accepted.as_ref()).map(|a| &a.scored.fitted.pred);
-    let gain = errs[pair].1.map_or(0.0, |after| 1.0 - after / errs[null].0);
     match pair_pred {
-        Some(p) if gain >= MIN_SWITCH_GAIN && significance::test(judge.y, null_pred, p, judge.held).significant => pair,
+        Some(p) if significance::test(judge.y, null_pred, p, judge.held).significant => pair,
         _ => null,
     }
 }
-
-/// Least relative drop of the held-out RMSE, from the best base alone to another base with its
-/// finding, for the diagnosis to switch: a term on a base of the wrong family takes up some of
-/// any misfit. Chosen on fresh17–fresh24 (2026-11-28): of the 19 switches gaining less than
-/// 30 %, 8 named a wrong effect or a null's (3 of those ranges' 9 false alarms); of the 783
-/// gaining more, 777 were right. Rerun with it, the 3 nulls were clean and 1 right case lost.
-pub const MIN_SWITCH_GAIN: f64 = 0.3;
 
 /// The notes a diagnosis carries about its base, the opening `chosen` (`names`: the input's
 /// and the output's): why it is not the best-fitting base, its play operators, its level

@@ -123,8 +123,8 @@ pub enum Set {
     /// A twenty-fifth held-out range, first run for the same report as fresh23, with the same
     /// method.
     Fresh24,
-    /// A twenty-sixth held-out range, first run for the report of 2026-11-28 (fifth: a switch of
-    /// base needs a 30 % gain).
+    /// A twenty-sixth held-out range, first run for the report of 2026-11-28 (fifth) with a rule
+    /// (a switch of base needs a 30 % gain) that was then taken out: docs/diagnose.md.
     Fresh25,
     /// A twenty-seventh held-out range, first run for the same report as fresh25, with the same
     /// method.
