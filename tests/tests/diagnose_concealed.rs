@@ -12,7 +12,7 @@
 //! - [`bench_table`] (ignored, about 25 minutes): the full table, per effect and per
 //!   excitation: `BENCH_SET=heldout cargo test --release -p integration-tests --test
 //!   diagnose_concealed -- --ignored --nocapture` (`BENCH_SET=dev` for the development
-//!   seeds, `fresh` … `fresh26` for the second to twenty-seventh held-out ranges; `BENCH_N`,
+//!   seeds, `fresh` … `fresh28` for the second to twenty-ninth held-out ranges; `BENCH_N`,
 //!   `BENCH_NULL` for the number of effect and null cases, default 256 and 48;
 //!   `BENCH_MIN_FS`, `BENCH_MAX_FS` keep only the cases sampled within those rates, Hz;
 //!   `BENCH_SEEDS=a,b,…` only the cases with those seeds, `BENCH_EFFECTS=e,…` only those
@@ -220,8 +220,27 @@ fn blind_subset_of_heldout_seeds() {
     assert!(all >= 0.65, "{:.1} % named first\n{t}", 100.0 * all);
 }
 
+/// Four nulls (fresh21 `145701067`, fresh22 `156100606` and `156102424`, fresh26 `213301017`:
+/// development since their reports) on which a term gained 7–9 % of the held-out RMSE,
+/// significant on the blocks, and was named: a finding needs 10 %
+/// (`significance::MIN_FINDING_GAIN`).
 #[test]
-#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh26|dev, BENCH_N, BENCH_NULL"]
+fn a_term_gaining_under_ten_percent_is_no_finding_on_a_null() {
+    let nulls = [
+        (Set::Fresh21, 145_701_067),
+        (Set::Fresh22, 156_100_606),
+        (Set::Fresh22, 156_102_424),
+        (Set::Fresh26, 213_301_017),
+    ];
+    for (set, seed) in nulls {
+        let c = cases(set, 200, 40).into_iter().find(|c| c.seed == seed).expect("the case");
+        let o = run(&c);
+        assert!(o.right(), "{}", line(&o));
+    }
+}
+
+#[test]
+#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh28|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
     let sets = Set::NAMED;
     let key = std::env::var("BENCH_SET").ok();
