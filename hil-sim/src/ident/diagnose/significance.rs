@@ -34,7 +34,7 @@ pub const MIN_GAIN: f64 = 0.03;
 /// fresh3 seeds, 2026-11-27): of the findings kept at [`MIN_GAIN`], 4 of the 9 on null
 /// recordings gained less than 7 %, none of the 434 right ones did. Raised to 10 % on the
 /// fresh17–fresh26 runs (400 nulls, 2,000 effect cases, development since their reports,
-/// 2026-11-28): 4 of the 9 first findings on nulls gained 7–9 %, 3 of about 1,580 right ones did.
+/// 2026-11-28): 4 of the 9 first findings on nulls gained 7–9 %, 3 of the 1,582 right ones did.
 pub const MIN_FINDING_GAIN: f64 = 0.10;
 /// Smallest drop of the held-out R-RMSE (seed 000 eq. 20, a share of the output's RMS) for a
 /// term to be kept as a finding: 0.05 % of the output, sixty times below the smallest effect
