@@ -12,7 +12,7 @@
 //! - [`bench_table`] (ignored, about 25 minutes): the full table, per effect and per
 //!   excitation: `BENCH_SET=heldout cargo test --release -p integration-tests --test
 //!   diagnose_concealed -- --ignored --nocapture` (`BENCH_SET=dev` for the development
-//!   seeds, `fresh` … `fresh28` for the second to twenty-ninth held-out ranges; `BENCH_N`,
+//!   seeds, `fresh` … `fresh30` for the second to thirty-first held-out ranges; `BENCH_N`,
 //!   `BENCH_NULL` for the number of effect and null cases, default 256 and 48;
 //!   `BENCH_MIN_FS`, `BENCH_MAX_FS` keep only the cases sampled within those rates, Hz;
 //!   `BENCH_SEEDS=a,b,…` only the cases with those seeds, `BENCH_EFFECTS=e,…` only those
@@ -240,7 +240,7 @@ fn a_term_gaining_under_ten_percent_is_no_finding_on_a_null() {
 }
 
 #[test]
-#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh28|dev, BENCH_N, BENCH_NULL"]
+#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh30|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
     let sets = Set::NAMED;
     let key = std::env::var("BENCH_SET").ok();

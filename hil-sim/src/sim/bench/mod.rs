@@ -135,6 +135,11 @@ pub enum Set {
     /// A twenty-ninth held-out range, first run for the same report as fresh27, with the same
     /// method.
     Fresh28,
+    /// A thirtieth held-out range, first run for the report of 2026-11-28 (seventh: the method of
+    /// fresh27, unchanged, on more seeds).
+    Fresh29,
+    /// A thirty-first held-out range, first run for the same report as fresh29.
+    Fresh30,
 }
 
 impl Set {
@@ -170,6 +175,8 @@ impl Set {
         ("fresh26", Set::Fresh26),
         ("fresh27", Set::Fresh27),
         ("fresh28", Set::Fresh28),
+        ("fresh29", Set::Fresh29),
+        ("fresh30", Set::Fresh30),
     ];
 
     /// The seed of case `k` of this set.
@@ -205,6 +212,8 @@ impl Set {
             Set::Fresh26 => 202_000_000 + 113 * k,
             Set::Fresh27 => 214_000_000 + 127 * k,
             Set::Fresh28 => 228_000_000 + 131 * k,
+            Set::Fresh29 => 244_000_000 + 137 * k,
+            Set::Fresh30 => 260_000_000 + 139 * k,
         }
     }
 }
