@@ -12,11 +12,12 @@
 //! - [`bench_table`] (ignored, about 25 minutes): the full table, per effect and per
 //!   excitation: `BENCH_SET=heldout cargo test --release -p integration-tests --test
 //!   diagnose_concealed -- --ignored --nocapture` (`BENCH_SET=dev` for the development
-//!   seeds, `fresh` … `fresh30` for the second to thirty-first held-out ranges; `BENCH_N`,
+//!   seeds, `fresh` … `fresh32` for the second to thirty-third held-out ranges; `BENCH_N`,
 //!   `BENCH_NULL` for the number of effect and null cases, default 256 and 48;
 //!   `BENCH_MIN_FS`, `BENCH_MAX_FS` keep only the cases sampled within those rates, Hz;
 //!   `BENCH_SEEDS=a,b,…` only the cases with those seeds, `BENCH_EFFECTS=e,…` only those
-//!   concealing these effects; `BENCH_WRITE=DIR` writes each case's
+//!   concealing these effects; `BENCH_FAMILIES=f,…` the base families, e.g. seed 000's own
+//!   `bouc_wen_n1,algebraic` beside `dahl` (`plant::MORE_FAMILIES`); `BENCH_WRITE=DIR` writes each case's
 //!   recording to `DIR/<seed>.csv`, to diagnose it by hand). It prints one line per case and writes
 //!   `target/bench_<set>.md`; `BENCH_DUMP=FILE` appends a JSON line per case (the case,
 //!   the findings, every candidate tested with its statistics) for studying a decision rule
@@ -29,7 +30,7 @@ use hil_sim::ident::dataset::prepare_recording;
 use hil_sim::ident::diagnose::{diagnose, DiagnoseOptions};
 use hil_sim::io::recording::Channels;
 use hil_sim::progress::NoProgress;
-use hil_sim::sim::bench::{cases, generate, Case, Set, EFFECTS, EXCITATIONS};
+use hil_sim::sim::bench::{cases, cases_of, generate, Case, Set, EFFECTS, EXCITATIONS};
 
 struct Outcome {
     case: Case,
@@ -239,8 +240,23 @@ fn a_term_gaining_under_ten_percent_is_no_finding_on_a_null() {
     }
 }
 
+/// Seed 000 fits the clutch with a Bouc–Wen loop of exponent `n = 1`; the base was fitted
+/// with `n = 2` only, and on three of ten such nulls (held-out set, these families: a run of
+/// 2026-11-28) LuGre with a field lag predicted the held-out part better than any base
+/// alone: a false alarm. With `n = 1` as a variant of the base's search they give no finding.
 #[test]
-#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh30|dev, BENCH_N, BENCH_NULL"]
+fn a_bouc_wen_loop_of_exponent_one_is_the_base_not_a_finding() {
+    let all = cases_of(Set::Heldout, 60, 30, &["bouc_wen_n1", "algebraic", "dahl"]);
+    for seed in [8_000_000, 8_000_021, 8_000_189] {
+        let c = all.iter().find(|c| c.seed == seed).expect("the case");
+        assert_eq!(c.family, "bouc_wen_n1");
+        let o = run(c);
+        assert!(o.right(), "{}", line(&o));
+    }
+}
+
+#[test]
+#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh32|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
     let sets = Set::NAMED;
     let key = std::env::var("BENCH_SET").ok();
@@ -258,7 +274,12 @@ fn bench_table() {
     // BENCH_EFFECTS: only the cases concealing these effects (comma-separated; `none` for the nulls).
     let effects: Vec<String> =
         std::env::var("BENCH_EFFECTS").map(|v| v.split(',').map(|s| s.trim().to_owned()).collect()).unwrap_or_default();
-    let all: Vec<Case> = cases(set, n, n_null)
+    // BENCH_FAMILIES: the base families (comma-separated; default the bench's five).
+    let families: Vec<String> = std::env::var("BENCH_FAMILIES")
+        .map(|v| v.split(',').map(|s| s.trim().to_owned()).collect())
+        .unwrap_or_default();
+    let families: Vec<&str> = families.iter().map(String::as_str).collect();
+    let all: Vec<Case> = cases_of(set, n, n_null, &families)
         .into_iter()
         .filter(|c| c.fs_hz >= fs.0 && c.fs_hz <= fs.1)
         .filter(|c| only.is_empty() || only.contains(&c.seed))

@@ -178,6 +178,10 @@ pub struct FitResult {
     pub flat: Vec<f64>,
     #[serde(skip)]
     pub rate_choice: RateSpec,
+    /// The variant of the model's search the parameters belong to
+    /// ([`crate::models::HostModel::variant`]; 0: the model's spec).
+    #[serde(skip)]
+    pub variant: usize,
     /// The replayed output over the whole recording.
     #[serde(skip)]
     pub output: Vec<f64>,
@@ -317,6 +321,12 @@ fn finish(
 ) -> Result<FitResult, FitError> {
     let info = model_core::registry::find(id).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
     let Searched { sp, scales, sim, samples, starts, kin, rows, constant_u, mut params, mut evaluations, .. } = found;
+    // The variant the search kept: its held values and box, not the model's spec's.
+    let variant = found.variant;
+    let sp = match variant {
+        0 => sp,
+        k => crate::models::host(id).and_then(|h| h.variant(&sp, k, &scales)).unwrap_or(sp),
+    };
     let (delay, delay_u) = found.delays;
     let started = Instant::now();
     let dt = data.dt as f32;
@@ -393,6 +403,7 @@ fn finish(
         held_params,
         flat: params,
         rate_choice: sp.rate,
+        variant,
         output,
     })
 }

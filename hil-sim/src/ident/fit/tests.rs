@@ -90,3 +90,17 @@ fn a_delay_at_the_edge_is_held_at_zero_and_refitted_from_the_first_search() {
     // The first search plus the refit cost less than one and a half new searches (two before).
     assert!(2 * auto.evaluations < 3 * zero.evaluations, "{} vs {} runs", auto.evaluations, zero.evaluations);
 }
+
+/// Seed 000 fits the clutch with a Bouc–Wen loop of exponent `n = 1`: the search's variant
+/// finds it, and the fitted set keeps it through the holding of undetermined parameters
+/// (which refits on the variant's box, not the model's `n = 2`). A loop of `n = 2` keeps 2.
+#[test]
+fn a_bouc_wen_loop_of_exponent_one_is_fitted_with_it() {
+    for n in [1.0f32, 2.0] {
+        let data = lagged("bouc_wen", &[3.0, 2.0, 1.0, 1.0, n, 0.4, 0.8, 0.0], 0.0, false);
+        let r = fit("bouc_wen", &data, &opts(DelayChoice::Off)).unwrap();
+        assert_eq!(r.flat[4], f64::from(n), "n = {n}: {:?}", r.flat);
+        assert_eq!(r.variant, if n == 1.0 { 1 } else { 0 });
+        assert!(r.heldout.r_rmse < 1e-3, "n = {n}: held-out R-RMSE {}", r.heldout.r_rmse);
+    }
+}

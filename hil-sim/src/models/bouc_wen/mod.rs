@@ -6,7 +6,7 @@ pub(crate) mod reference;
 use model_core::models::bouc_wen::Registered;
 
 use super::reference::Case;
-use super::search::{ParamSpec, Scales, SearchBox, Spreads, Strategy};
+use super::search::{ModelSpec, ParamSpec, Scales, SearchBox, Spreads, Strategy};
 use super::HostModel;
 
 impl HostModel for Registered {
@@ -29,6 +29,23 @@ impl HostModel for Registered {
             ],
             Strategy::Global,
         ))
+    }
+
+    /// `n = 1`, seed 000's own fit of the clutch (eq. 3–4): a sharper knee than `n = 2`.
+    /// β and γ multiply `|z|ⁿ` with z in units of x, so their box scales by x once less.
+    fn variant(sp: &ModelSpec, k: usize, s: &Scales) -> Option<ModelSpec> {
+        if k != 1 {
+            return None;
+        }
+        let mut v = sp.clone();
+        v.hold("n", 1.0);
+        let x = Spreads::of(s).x;
+        for p in v.params.iter_mut().filter(|p| p.name == "beta" || p.name == "gamma") {
+            p.lo *= x;
+            p.hi *= x;
+            p.start *= x;
+        }
+        Some(v)
     }
 
     fn reference_cases() -> Vec<Case> {

@@ -40,7 +40,7 @@ use serde::Serialize;
 
 use crate::io::recording::Recording;
 pub use effects::EFFECTS;
-pub use plant::FAMILIES;
+pub use plant::{FAMILIES, MORE_FAMILIES};
 pub use signals::EXCITATIONS;
 
 /// Ambient and starting temperature, °C.
@@ -140,6 +140,10 @@ pub enum Set {
     Fresh29,
     /// A thirty-first held-out range, first run for the same report as fresh29.
     Fresh30,
+    /// The thirty-second and thirty-third held-out ranges, first run for the eighth report of
+    /// 2026-11-28 (Bouc–Wen base with the `n = 1` variant).
+    Fresh31,
+    Fresh32,
 }
 
 impl Set {
@@ -177,6 +181,8 @@ impl Set {
         ("fresh28", Set::Fresh28),
         ("fresh29", Set::Fresh29),
         ("fresh30", Set::Fresh30),
+        ("fresh31", Set::Fresh31),
+        ("fresh32", Set::Fresh32),
     ];
 
     /// The seed of case `k` of this set.
@@ -214,6 +220,8 @@ impl Set {
             Set::Fresh28 => 228_000_000 + 131 * k,
             Set::Fresh29 => 244_000_000 + 137 * k,
             Set::Fresh30 => 260_000_000 + 139 * k,
+            Set::Fresh31 => 276_000_000 + 149 * k,
+            Set::Fresh32 => 292_000_000 + 151 * k,
         }
     }
 }
@@ -261,17 +269,24 @@ impl Case {
 /// The `n` effect cases and `n_null` null cases of a set: effects, excitations and families
 /// cycled so that every effect meets every excitation and the families rotate.
 pub fn cases(set: Set, n: usize, n_null: usize) -> Vec<Case> {
+    cases_of(set, n, n_null, FAMILIES)
+}
+
+/// [`cases`] on the base families `families` (of [`FAMILIES`] and [`MORE_FAMILIES`]).
+/// An empty `families` is [`FAMILIES`].
+pub fn cases_of(set: Set, n: usize, n_null: usize, families: &[&str]) -> Vec<Case> {
+    let families = if families.is_empty() { FAMILIES } else { families };
     let effects: Vec<&str> = EFFECTS.iter().map(|(e, _)| *e).collect();
     let mut out = Vec::with_capacity(n + n_null);
     for k in 0..n {
         let e = effects[k % effects.len()];
         let x = EXCITATIONS[(k / effects.len()) % EXCITATIONS.len()];
-        let f = FAMILIES[(k + k / (effects.len() * EXCITATIONS.len())) % FAMILIES.len()];
+        let f = families[(k + k / (effects.len() * EXCITATIONS.len())) % families.len()];
         out.push(Case::draw(e, f, x, set.seed(k as u64)));
     }
     for k in 0..n_null {
         let x = EXCITATIONS[k % EXCITATIONS.len()];
-        let f = FAMILIES[k % FAMILIES.len()];
+        let f = families[k % families.len()];
         out.push(Case::draw("none", f, x, set.seed(100_000 + k as u64)));
     }
     out
@@ -309,7 +324,7 @@ pub struct World {
 /// Why a case cannot be generated.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum BenchError {
-    #[error("unknown base family `{0}` (one of: {list})", list = FAMILIES.join(", "))]
+    #[error("unknown base family `{0}` (one of: {list}, {more})", list = FAMILIES.join(", "), more = MORE_FAMILIES.join(", "))]
     Family(String),
     #[error("the base family `{0}` diverged")]
     Diverged(String),
@@ -339,7 +354,7 @@ impl World {
             .collect();
         let domega = signals::derivative(&speed, dt);
         let base = plant::torque(&c.family, &b, &db, dt).ok_or_else(|| {
-            if FAMILIES.contains(&c.family.as_str()) {
+            if FAMILIES.contains(&c.family.as_str()) || MORE_FAMILIES.contains(&c.family.as_str()) {
                 BenchError::Diverged(c.family.clone())
             } else {
                 BenchError::Family(c.family.clone())
