@@ -12,13 +12,14 @@
 //! - [`bench_table`] (ignored, about 25 minutes): the full table, per effect and per
 //!   excitation: `BENCH_SET=heldout cargo test --release -p integration-tests --test
 //!   diagnose_concealed -- --ignored --nocapture` (`BENCH_SET=dev` for the development
-//!   seeds, `fresh` … `fresh32` for the second to thirty-third held-out ranges; `BENCH_N`,
+//!   seeds, `fresh` … `fresh33` for the second to thirty-fourth held-out ranges; `BENCH_N`,
 //!   `BENCH_NULL` for the number of effect and null cases, default 256 and 48;
 //!   `BENCH_MIN_FS`, `BENCH_MAX_FS` keep only the cases sampled within those rates, Hz;
 //!   `BENCH_SEEDS=a,b,…` only the cases with those seeds, `BENCH_EFFECTS=e,…` only those
 //!   concealing these effects; `BENCH_FAMILIES=f,…` the base families, e.g. seed 000's own
 //!   `bouc_wen_n1,algebraic` beside `dahl` (`plant::MORE_FAMILIES`); `BENCH_WRITE=DIR` writes each case's
-//!   recording to `DIR/<seed>.csv`, to diagnose it by hand). It prints one line per case and writes
+//!   recording to `DIR/<seed>.csv`, to diagnose it by hand; `BENCH_WRITE_ONLY=DIR` writes them and
+//!   diagnoses none). It prints one line per case and writes
 //!   `target/bench_<set>.md`; `BENCH_DUMP=FILE` appends a JSON line per case (the case,
 //!   the findings, every candidate tested with its statistics) for studying a decision rule
 //!   offline.
@@ -256,7 +257,7 @@ fn a_bouc_wen_loop_of_exponent_one_is_the_base_not_a_finding() {
 }
 
 #[test]
-#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh32|dev, BENCH_N, BENCH_NULL"]
+#[ignore = "the full bench (~25 min): BENCH_SET=heldout|fresh|fresh2…fresh33|dev, BENCH_N, BENCH_NULL"]
 fn bench_table() {
     let sets = Set::NAMED;
     let key = std::env::var("BENCH_SET").ok();
@@ -286,6 +287,17 @@ fn bench_table() {
         .filter(|c| effects.is_empty() || effects.contains(&c.effect))
         .collect();
     let (from, to) = (env("BENCH_FROM", 0).min(all.len()), env("BENCH_TO", all.len()).min(all.len()));
+    // BENCH_WRITE_ONLY=DIR: write the recordings as `DIR/<seed>.csv` and diagnose none.
+    if let Ok(dir) = std::env::var("BENCH_WRITE_ONLY") {
+        for c in &all[from..to.max(from)] {
+            let g = generate(c).unwrap_or_else(|e| panic!("{c:?}: {e}"));
+            let path = Path::new(&dir).join(format!("{}.csv", c.seed));
+            let file =
+                std::fs::File::create(&path).unwrap_or_else(|e| panic!("BENCH_WRITE_ONLY {}: {e}", path.display()));
+            g.recording.write_csv(std::io::BufWriter::new(file)).expect("BENCH_WRITE_ONLY");
+        }
+        return;
+    }
     let outcomes = run_all(&all[from..to.max(from)]);
     let t = table(&outcomes);
     println!("{t}");

@@ -144,6 +144,9 @@ pub enum Set {
     /// 2026-11-28 (Bouc–Wen base with the `n = 1` variant).
     Fresh31,
     Fresh32,
+    /// The thirty-fourth, first run for the same report on seed 000's clutch models beside
+    /// three of the bench's families (`BENCH_FAMILIES=bouc_wen_n1,algebraic,kwok,dahl,bouc_wen`).
+    Fresh33,
 }
 
 impl Set {
@@ -183,6 +186,7 @@ impl Set {
         ("fresh30", Set::Fresh30),
         ("fresh31", Set::Fresh31),
         ("fresh32", Set::Fresh32),
+        ("fresh33", Set::Fresh33),
     ];
 
     /// The seed of case `k` of this set.
@@ -222,6 +226,7 @@ impl Set {
             Set::Fresh30 => 260_000_000 + 139 * k,
             Set::Fresh31 => 276_000_000 + 149 * k,
             Set::Fresh32 => 292_000_000 + 151 * k,
+            Set::Fresh33 => 308_000_000 + 157 * k,
         }
     }
 }
