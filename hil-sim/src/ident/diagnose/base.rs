@@ -289,6 +289,21 @@ mod tests {
         assert_eq!(without_bend_over(spec("bouc_wen")).params, spec("bouc_wen").params);
     }
 
+    /// The refits search the box of the variant the fit kept: `n` held at 1 for Bouc–Wen's
+    /// `n = 1` variant (the model's own spec holds it at 2).
+    #[test]
+    fn a_base_is_refitted_on_the_variant_its_fit_kept() {
+        let data = crate::ident::diagnose::tests::recording(None, 3);
+        let opts = FitOptions { delay: DelayChoice::Off, lm_iterations: 4, ..Default::default() };
+        let fitted = fit("bouc_wen", &data, &opts).unwrap();
+        let n_of = |variant: usize| {
+            let base = ready(&data, FitResult { variant, ..fitted.clone() }, true).unwrap();
+            base.spec.params.iter().find(|p| p.name == "n").map(|p| (p.fixed, p.start)).unwrap()
+        };
+        assert_eq!(n_of(0), (true, 2.0));
+        assert_eq!(n_of(1), (true, 1.0));
+    }
+
     #[test]
     fn the_reversed_split_holds_out_the_head_as_long_as_the_tail() {
         let data = crate::ident::diagnose::tests::recording(None, 3);
