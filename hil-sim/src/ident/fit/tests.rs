@@ -92,8 +92,8 @@ fn a_delay_at_the_edge_is_held_at_zero_and_refitted_from_the_first_search() {
 }
 
 /// Seed 000 fits the clutch with a Bouc–Wen loop of exponent `n = 1`: the search's variant
-/// finds it, and the fitted set keeps it through the holding of undetermined parameters
-/// (which refits on the variant's box, not the model's `n = 2`). A loop of `n = 2` keeps 2.
+/// finds it and the result says so (`FitResult::variant`, which a diagnosis refits on). A
+/// loop of `n = 2` keeps the model's spec.
 #[test]
 fn a_bouc_wen_loop_of_exponent_one_is_fitted_with_it() {
     for n in [1.0f32, 2.0] {
