@@ -528,68 +528,8 @@ fn identify(
             .ok_or_else(|| FitError::NoValidSet { model: id.to_owned() })?;
             valid_or_err(id, sim, t, evals)
         }
-        Strategy::Global => global_fit(id, sp, sim, (kin, y, rows), y_scale, opts, notes, &full),
+        Strategy::Global => global::global_fit(id, sp, sim, (kin, y, rows), y_scale, opts, notes, &full),
     }
-}
-
-/// [`Strategy::Global`]: restarts of the global search (swarm on a window, then LM on it)
-/// until two agree, then LM on the whole training part.
-#[allow(clippy::too_many_arguments)]
-fn global_fit(
-    id: &str,
-    sp: &ModelSpec,
-    sim: &dyn simulate::Simulator,
-    (kin, y, rows): (&[model_core::Kin], &[f64], &[usize]),
-    y_scale: f64,
-    opts: &FitOptions,
-    notes: &restarts::Notes,
-    full: &Objective<'_>,
-) -> Result<(Vec<f64>, usize), FitError> {
-    let window_rows: Vec<usize> = rows.iter().copied().filter(|&i| i < opts.swarm_window).collect();
-    let window_rows = if window_rows.len() < 20 { rows.to_vec() } else { window_rows };
-    let win = Objective::new(sim, sp, kin, y, &window_rows, y_scale);
-    let polished_start = std::sync::OnceLock::new(); // the papers' start polished: the same every restart
-    let mut evals = 0;
-    let mut failure = None;
-    let best = restarts::until_agree(
-        &format!("the {id} global search"),
-        opts.swarm.seed,
-        restarts::MAX_STARTS,
-        notes,
-        |seed| {
-            let swarm = SwarmOptions { seed, ..opts.swarm };
-            let search = |swarm| global::global_search(id, sp, (&win, full), opts, swarm, &polished_start);
-            let r = search(swarm).and_then(|first| match first {
-                (Some(best), e, _) => Ok((Some(best), e)),
-                // A box where the small swarm found nothing valid (a start that is not a
-                // published set, a narrow valid region) gets a wider search before giving
-                // up; not one where it did and the polished points are not valid on the
-                // whole training part (the wider swarm searches the same window: GPI on
-                // `ranran_50.csv` ran it seven times for nothing valid).
-                (None, e, true) => Ok((None, e)),
-                (None, e, false) => search(SwarmOptions::wide(seed)).map(|(b, more, _)| (b, e + more)),
-            });
-            match r {
-                Ok((b, e)) => {
-                    evals += e;
-                    b.map(|b| {
-                        let c = b.cost;
-                        (b, c)
-                    })
-                }
-                Err(e) => {
-                    failure = failure.take().or(Some(e));
-                    None
-                }
-            }
-        },
-    );
-    let Some(best) = best else {
-        return Err(failure.unwrap_or_else(|| FitError::NoValidSet { model: id.to_owned() }));
-    };
-    let r = lm::minimize_reduced(full, &best.params, opts.lm_iterations);
-    evals += r.evaluations;
-    valid_or_err(id, sim, r.params, evals)
 }
 
 fn valid_or_err(
