@@ -34,21 +34,12 @@ pub const MORE_FAMILIES: &[&str] = &["bouc_wen_n1", "algebraic"];
 pub fn torque(family: &str, b: &[f64], db: &[f64], dt: f64) -> Option<Vec<f64>> {
     let out: Vec<f64> = match family {
         "kwok" => b.iter().zip(db).map(|(b, d)| 0.8 + 22.0 * b + 0.01 * d + 1.5 * (0.6 * d).tanh()).collect(),
-        "bouc_wen" => {
-            let (a, beta, gamma, n) = (1.0, 60.0, 20.0, 1.5);
-            let mut z = 0.0f64;
-            let h = dt / 4.0;
-            b.iter()
-                .zip(db)
-                .map(|(b, d)| {
-                    for _ in 0..4 {
-                        let az = z.abs();
-                        z += h * (a * d - beta * d.abs() * az.powf(n - 1.0) * z - gamma * d * az.powf(n));
-                    }
-                    1.0 + 20.0 * b.signum() * b.abs().powf(1.3) + 55.0 * z + 0.01 * d
-                })
-                .collect()
-        }
+        "bouc_wen" => b
+            .iter()
+            .zip(db)
+            .zip(bouc_wen_z(db, dt, (1.0, 60.0, 20.0, 1.5)))
+            .map(|((b, d), z)| 1.0 + 20.0 * b.signum() * b.abs().powf(1.3) + 55.0 * z + 0.01 * d)
+            .collect(),
         "dahl" => {
             let sigma = 15.0;
             let mut z = 0.0f64;
@@ -77,20 +68,12 @@ pub fn torque(family: &str, b: &[f64], db: &[f64], dt: f64) -> Option<Vec<f64>> 
                 })
                 .collect()
         }
-        "bouc_wen_n1" => {
-            let (a, beta, gamma) = (1.0, 40.0, 10.0);
-            let mut z = 0.0f64;
-            let h = dt / 4.0;
-            b.iter()
-                .zip(db)
-                .map(|(b, d)| {
-                    for _ in 0..4 {
-                        z += h * (a * d - beta * d.abs() * z - gamma * d * z.abs());
-                    }
-                    1.0 + 22.0 * b + 150.0 * z + 0.01 * d
-                })
-                .collect()
-        }
+        "bouc_wen_n1" => b
+            .iter()
+            .zip(db)
+            .zip(bouc_wen_z(db, dt, (1.0, 40.0, 10.0, 1.0)))
+            .map(|((b, d), z)| 1.0 + 22.0 * b + 150.0 * z + 0.01 * d)
+            .collect(),
         "algebraic" => b.iter().zip(db).map(|(b, d)| 0.8 + 18.0 * b + 0.25 * d + 40.0 * b.abs() * b.powi(3)).collect(),
         "bingham" => b
             .iter()
@@ -100,6 +83,23 @@ pub fn torque(family: &str, b: &[f64], db: &[f64], dt: f64) -> Option<Vec<f64>> 
         _ => return None,
     };
     out.iter().all(|v| v.is_finite()).then_some(out)
+}
+
+/// The Bouc–Wen state `z` at each sample for the rate `db` (T/s), sample interval `dt` (s):
+/// `ż = A·ḃ − β·|ḃ|·|z|^{n−1}·z − γ·ḃ·|z|^n` from rest, four Euler sub-steps per sample with
+/// the rate held over it.
+fn bouc_wen_z(db: &[f64], dt: f64, (a, beta, gamma, n): (f64, f64, f64, f64)) -> Vec<f64> {
+    let mut z = 0.0f64;
+    let h = dt / 4.0;
+    db.iter()
+        .map(|d| {
+            for _ in 0..4 {
+                let az = z.abs();
+                z += h * (a * d - beta * d.abs() * az.powf(n - 1.0) * z - gamma * d * az.powf(n));
+            }
+            z
+        })
+        .collect()
 }
 
 #[cfg(test)]
