@@ -100,6 +100,15 @@ impl Host {
         (self.variant)(sp, k, s)
     }
 
+    /// The search `sp` as its variant `k`: `sp` itself for `k = 0`, else [`Host::variant`].
+    pub fn at_variant(&self, sp: &ModelSpec, k: usize, s: &Scales) -> Option<ModelSpec> {
+        if k == 0 {
+            Some(sp.clone())
+        } else {
+            self.variant(sp, k, s)
+        }
+    }
+
     /// The regressor row at one sample (`None` for a model that is not linear).
     pub fn regressors(&self, k: &Kin) -> Option<Vec<f64>> {
         let mut row = [0.0; MAX_REGRESSORS];

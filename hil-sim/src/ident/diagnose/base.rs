@@ -158,14 +158,7 @@ fn ready(data: &Dataset, fit: FitResult, held: bool) -> Result<Base, DiagnoseErr
     // The refits search the box of the variant the fit kept (its held values included).
     let scales = data.scales();
     let spec = crate::models::host(&id)
-        .and_then(|h| {
-            let sp = h.spec(&scales, Some(fit.rate_choice))?;
-            if fit.variant == 0 {
-                Some(sp)
-            } else {
-                h.variant(&sp, fit.variant, &scales)
-            }
-        })
+        .and_then(|h| h.at_variant(&h.spec(&scales, Some(fit.rate_choice))?, fit.variant, &scales))
         .ok_or_else(|| DiagnoseError::NotParametric(id.clone()))?;
     if !matches!(spec.strategy, Strategy::Linear | Strategy::Local | Strategy::Global) {
         return Err(DiagnoseError::NotParametric(id));

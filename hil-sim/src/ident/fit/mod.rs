@@ -323,10 +323,7 @@ fn finish(
     let Searched { sp, scales, sim, samples, starts, kin, rows, constant_u, mut params, mut evaluations, .. } = found;
     // The variant the search kept: its held values and box, not the model's spec's.
     let variant = found.variant;
-    let sp = match variant {
-        0 => sp,
-        k => crate::models::host(id).and_then(|h| h.variant(&sp, k, &scales)).unwrap_or(sp),
-    };
+    let sp = crate::models::host(id).and_then(|h| h.at_variant(&sp, variant, &scales)).unwrap_or(sp);
     let (delay, delay_u) = found.delays;
     let started = Instant::now();
     let dt = data.dt as f32;

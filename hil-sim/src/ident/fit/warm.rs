@@ -21,10 +21,7 @@ pub(super) fn warm_fit(
     opts: &FitOptions,
     notes: &restarts::Notes,
 ) -> Result<Identified, FitError> {
-    let v = match variant {
-        0 => Some(sp.clone()),
-        k => crate::models::host(sp.id).and_then(|h| h.variant(sp, k, scales)),
-    };
+    let v = crate::models::host(sp.id).and_then(|h| h.at_variant(sp, variant, scales));
     let Some(mut v) = v.filter(|v| matches!(v.strategy, Strategy::Global | Strategy::Projected)) else {
         return identify_variants(id, sp, sim, kin, y, rows, scales, opts, notes);
     };
