@@ -54,12 +54,17 @@ impl Outcome {
     }
 }
 
+/// Write `g`'s recording as `DIR/<seed>.csv` (`var`: the variable that named DIR, for the message).
+fn write(var: &str, dir: &str, c: &Case, g: &hil_sim::sim::bench::Generated) {
+    let path = Path::new(dir).join(format!("{}.csv", c.seed));
+    let file = std::fs::File::create(&path).unwrap_or_else(|e| panic!("{var} {}: {e}", path.display()));
+    g.recording.write_csv(std::io::BufWriter::new(file)).unwrap_or_else(|e| panic!("{var} {}: {e}", path.display()));
+}
+
 fn run(c: &Case) -> Outcome {
     let g = generate(c).unwrap_or_else(|e| panic!("{c:?}: {e}"));
     if let Ok(dir) = std::env::var("BENCH_WRITE") {
-        let path = std::path::Path::new(&dir).join(format!("{}.csv", c.seed));
-        let file = std::fs::File::create(&path).unwrap_or_else(|e| panic!("BENCH_WRITE {}: {e}", path.display()));
-        g.recording.write_csv(std::io::BufWriter::new(file)).expect("BENCH_WRITE");
+        write("BENCH_WRITE", &dir, c, &g);
     }
     let ch = Channels::default();
     let prepared = prepare_recording(g.recording, &ch, 0.7, false).expect("dataset");
@@ -290,11 +295,7 @@ fn bench_table() {
     // BENCH_WRITE_ONLY=DIR: write the recordings as `DIR/<seed>.csv` and diagnose none.
     if let Ok(dir) = std::env::var("BENCH_WRITE_ONLY") {
         for c in &all[from..to.max(from)] {
-            let g = generate(c).unwrap_or_else(|e| panic!("{c:?}: {e}"));
-            let path = Path::new(&dir).join(format!("{}.csv", c.seed));
-            let file =
-                std::fs::File::create(&path).unwrap_or_else(|e| panic!("BENCH_WRITE_ONLY {}: {e}", path.display()));
-            g.recording.write_csv(std::io::BufWriter::new(file)).expect("BENCH_WRITE_ONLY");
+            write("BENCH_WRITE_ONLY", &dir, c, &generate(c).unwrap_or_else(|e| panic!("{c:?}: {e}")));
         }
         return;
     }
