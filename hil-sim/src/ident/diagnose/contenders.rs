@@ -25,7 +25,7 @@ use super::{level_map, rank, significance};
 use crate::ident::fit::Dataset;
 
 /// Radii of the play operators, fractions of the input's span.
-pub const PLAY_RADII: &[f64] = &[0.01, 0.03, 0.07, 0.15];
+pub const PLAY_RADII: &[f64] = &[0.01, 0.02, 0.03, 0.05, 0.07, 0.10, 0.15];
 /// Gauss–Newton iterations that converge a fitted base before its first round.
 const BASE_ITERATIONS: usize = 8;
 

@@ -147,6 +147,10 @@ pub enum Set {
     /// The thirty-fourth, first run for the same report on seed 000's clutch models beside
     /// three of the bench's families (`BENCH_FAMILIES=bouc_wen_n1,algebraic,kwok,dahl,bouc_wen`).
     Fresh33,
+    /// The thirty-fifth and thirty-sixth, first run for the ninth report of 2026-11-28 (seven
+    /// play radii on the play base).
+    Fresh34,
+    Fresh35,
 }
 
 impl Set {
@@ -187,6 +191,8 @@ impl Set {
         ("fresh31", Set::Fresh31),
         ("fresh32", Set::Fresh32),
         ("fresh33", Set::Fresh33),
+        ("fresh34", Set::Fresh34),
+        ("fresh35", Set::Fresh35),
     ];
 
     /// The seed of case `k` of this set.
@@ -227,6 +233,8 @@ impl Set {
             Set::Fresh31 => 276_000_000 + 149 * k,
             Set::Fresh32 => 292_000_000 + 151 * k,
             Set::Fresh33 => 308_000_000 + 157 * k,
+            Set::Fresh34 => 324_000_000 + 163 * k,
+            Set::Fresh35 => 342_000_000 + 167 * k,
         }
     }
 }
