@@ -24,7 +24,10 @@ use super::options::DiagnoseError;
 use super::{level_map, rank, significance};
 use crate::ident::fit::Dataset;
 
-/// Radii of the play operators, fractions of the input's span.
+/// Radii of the play operators, fractions of the input's span: seven, each at most twice the
+/// one before (four, 1, 3, 7 and 15 %, until 2026-11-28: a loop of plays between those
+/// radii was met by a saturating map of the input, which the plays follow and which so moved
+/// their radii, and named `saturation` on play-type nulls).
 pub const PLAY_RADII: &[f64] = &[0.01, 0.02, 0.03, 0.05, 0.07, 0.10, 0.15];
 /// Gauss–Newton iterations that converge a fitted base before its first round.
 const BASE_ITERATIONS: usize = 8;
