@@ -45,6 +45,11 @@ pub trait HostModel: Model {
     /// The model-specific structure the fitting method exploits.
     const STRUCTURE: Structure = Structure::Generic;
 
+    /// Parameters the output is affine in, jointly, once the others are fixed (tanh: `α, c,
+    /// k, T₀`): the global search also starts from a grid over the others with these solved
+    /// by least squares ([`crate::ident::fit::separable`]). Empty: none.
+    const AFFINE: &'static [&'static str] = &[];
+
     /// Variant `k ≥ 1` of the search (another value of a discrete parameter); the fit tries
     /// every variant and keeps the one with the lowest training cost. `None` past the last.
     fn variant(_sp: &ModelSpec, _k: usize, _s: &Scales) -> Option<ModelSpec> {
@@ -69,6 +74,8 @@ pub trait HostModel: Model {
 pub struct Host {
     pub id: &'static str,
     pub structure: Structure,
+    /// [`HostModel::AFFINE`].
+    pub affine: &'static [&'static str],
     search: fn(&Scales) -> Option<SearchBox>,
     variant: fn(&ModelSpec, usize, &Scales) -> Option<ModelSpec>,
     regressors: fn(&Kin, &mut [f64; MAX_REGRESSORS]) -> Option<usize>,
@@ -80,6 +87,7 @@ impl Host {
         Self {
             id: M::ID,
             structure: M::STRUCTURE,
+            affine: M::AFFINE,
             search: M::search,
             variant: M::variant,
             regressors: M::regressors,

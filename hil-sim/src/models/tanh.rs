@@ -7,6 +7,9 @@ use super::search::{ParamSpec, Scales, SearchBox, Spreads, Strategy};
 use super::HostModel;
 
 impl HostModel for Registered {
+    /// Eq. 11: `T = c·Ḃ + k·B + α·z + T₀` with `z` free of all four.
+    const AFFINE: &'static [&'static str] = &["alpha", "c", "k", "t0"];
+
     fn search(s: &Scales) -> Option<SearchBox> {
         let Spreads { x, v, y, ym, big_y, .. } = Spreads::of(s);
         let p = ParamSpec::new;

@@ -1,7 +1,8 @@
 //! Global search for models with local minima (Bouc–Wen family, LuGre, Dahl, trig): a
 //! particle swarm (argmin's `ParticleSwarm`, costs evaluated in parallel) over the unit box
 //! of the free parameters, seeded with the spec's starting point. It returns the best few
-//! distinct points it saw, for Levenberg–Marquardt to polish; [`global_fit`] restarts it until
+//! distinct points it saw, for Levenberg–Marquardt to polish with the papers' start and the
+//! separable grid's best points ([`super::separable`]); [`global_fit`] restarts it until
 //! two starts agree.
 
 use std::sync::Mutex;
@@ -124,28 +125,45 @@ pub fn search(obj: &Objective<'_>, opts: SwarmOptions) -> Result<Vec<Candidate>,
     Ok(best.into_iter().map(|(c, u)| Candidate { params: obj.from_unit(&u), cost: c }).collect())
 }
 
+/// Starts that are the same on every restart of the global search: the papers' start and
+/// the best points of the separable grid ([`super::separable`]), polished once per fit.
+pub(super) struct FixedStarts {
+    starts: Vec<Vec<f64>>,
+    polished: std::sync::OnceLock<Vec<lm::LocalFit>>,
+}
+
+/// Grid points of [`super::separable`] polished beside the swarm's.
+const GRID_KEEP: usize = 2;
+
+impl FixedStarts {
+    /// The papers' start of `sp` and, for a model with affine parameters and `grid`, the
+    /// grid's best points on the window `win`.
+    pub(super) fn new(sp: &ModelSpec, win: &Objective<'_>, grid: bool) -> Self {
+        let mut starts = vec![sp.start()];
+        let affine = crate::models::host(sp.id).filter(|_| grid).map_or(&[][..], |h| h.affine);
+        starts.extend(super::separable::starts(win, affine, GRID_KEEP).into_iter().map(|c| c.params));
+        Self { starts, polished: std::sync::OnceLock::new() }
+    }
+}
+
 /// The global phase of [`Strategy::Global`]: swarm on the window, then every candidate and
-/// the papers' start polished there (the start once per fit: `polished_start` keeps it for
-/// the other starts of [`super::restarts::until_agree`]). Returns the candidate with the lowest cost
+/// the fixed starts polished there (the fixed ones once per fit, [`FixedStarts`], for all
+/// the starts of [`super::restarts::until_agree`]). Returns the candidate with the lowest cost
 /// on the whole training part (`None` when none is valid), the evaluations spent, and whether
 /// the swarm found any valid point on the window.
 pub(super) fn global_search(
     id: &str,
-    sp: &ModelSpec,
     (win, full): (&Objective<'_>, &Objective<'_>),
     opts: &FitOptions,
     swarm: SwarmOptions,
-    polished_start: &std::sync::OnceLock<lm::LocalFit>,
+    fixed: &FixedStarts,
 ) -> Result<(Option<lm::LocalFit>, usize, bool), FitError> {
     let mut cands = search(win, swarm).map_err(|e| FitError::Swarm { model: id.to_owned(), reason: e.to_string() })?;
     let found = !cands.is_empty();
     // The papers' starting values are always polished too: they are often in the
     // right basin already (Spencer's published set on the Dyke files is), and the
     // swarm offers the alternatives.
-    let start = sp.start();
-    if !cands.iter().any(|c| c.params == start) {
-        cands.push(Candidate { cost: win.cost(&start), params: start.clone() });
-    }
+    cands.retain(|c| !fixed.starts.contains(&c.params));
     // Polish every candidate on the window (in parallel), rank them by their cost on
     // the whole training part (one run each: the window alone does not tell
     // near-equal basins apart), then finish the best on the whole training part.
@@ -153,16 +171,17 @@ pub(super) fn global_search(
         let r = lm::minimize(win, p, opts.polish_iterations);
         lm::LocalFit { cost: full.cost(&r.params), evaluations: r.evaluations + 1, ..r }
     };
-    let polished: Vec<lm::LocalFit> = cands
-        .par_iter()
-        .map(|c| match (c.params == start, polished_start.get()) {
-            (true, Some(done)) => lm::LocalFit { evaluations: 0, ..done.clone() },
-            (true, None) => polished_start.get_or_init(|| polish(&start)).clone(),
-            (false, _) => polish(&c.params),
-        })
-        .collect();
-    let evals =
-        swarm.particles * (swarm.iterations as usize + 1) + polished.iter().map(|r| r.evaluations).sum::<usize>();
+    let mut polished: Vec<lm::LocalFit> = cands.par_iter().map(|c| polish(&c.params)).collect();
+    let mut fixed_evals = 0;
+    let done = fixed.polished.get_or_init(|| {
+        let r: Vec<lm::LocalFit> = fixed.starts.par_iter().map(|p| polish(p)).collect();
+        fixed_evals = r.iter().map(|r| r.evaluations).sum();
+        r
+    });
+    polished.extend(done.iter().cloned());
+    let evals = swarm.particles * (swarm.iterations as usize + 1)
+        + fixed_evals
+        + polished.iter().take(cands.len()).map(|r| r.evaluations).sum::<usize>();
     let best = polished.into_iter().filter(|r| r.cost.is_finite()).min_by(|a, b| a.cost.total_cmp(&b.cost));
     Ok((best, evals, found))
 }
@@ -183,7 +202,7 @@ pub(super) fn global_fit(
     let window_rows: Vec<usize> = rows.iter().copied().filter(|&i| i < opts.swarm_window).collect();
     let window_rows = if window_rows.len() < 20 { rows.to_vec() } else { window_rows };
     let win = Objective::new(sim, sp, kin, y, &window_rows, y_scale);
-    let polished_start = std::sync::OnceLock::new(); // the papers' start polished: the same every restart
+    let fixed = FixedStarts::new(sp, &win, opts.separable);
     let mut evals = 0;
     let mut failure = None;
     let best = restarts::until_agree(
@@ -193,7 +212,7 @@ pub(super) fn global_fit(
         notes,
         |seed| {
             let swarm = SwarmOptions { seed, ..opts.swarm };
-            let search = |swarm| global_search(id, sp, (&win, full), opts, swarm, &polished_start);
+            let search = |swarm| global_search(id, (&win, full), opts, swarm, &fixed);
             let r = search(swarm).and_then(|first| match first {
                 (Some(best), e, _) => Ok((Some(best), e)),
                 // A box where the small swarm found nothing valid (a start that is not a

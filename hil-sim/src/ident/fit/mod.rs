@@ -8,7 +8,8 @@
 //! - Methods: closed-form least squares ([`linear`]) where the model is linear in its
 //!   parameters; for the models with local minima, a small particle swarm ([`global`])
 //!   on a window of the training part, bounded Levenberg–Marquardt ([`lm`]) polishing its
-//!   best points and the papers' starting values on that window, and a final
+//!   best points, the papers' starting values and, for a model affine in some of its
+//!   parameters, the best points of a grid over the others ([`separable`]) on that window, and a final
 //!   Levenberg–Marquardt run on the whole training part from the candidate that scores best
 //!   there.
 //! - [`job`] runs `hil-sim fit` as one call (read, check, fit with progress, save).
@@ -29,6 +30,7 @@ pub mod objective;
 pub mod operator;
 mod per_run;
 pub mod restarts;
+pub mod separable;
 pub mod simulate;
 mod warm;
 
@@ -118,6 +120,9 @@ pub struct FitOptions {
     /// issue 3 (Spencer's model on 63k samples in 2 s); noiseless synthetic data, whose cost
     /// goes to zero, needs more to converge to its truth.
     pub polish_iterations: usize,
+    /// Whether the global search also starts from the separable grid ([`separable`]) of a
+    /// model with affine parameters (on by default).
+    pub separable: bool,
 }
 
 impl Default for FitOptions {
@@ -129,6 +134,7 @@ impl Default for FitOptions {
             swarm_window: 9_000,
             lm_iterations: 10,
             polish_iterations: 12,
+            separable: true,
         }
     }
 }

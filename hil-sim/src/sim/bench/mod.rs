@@ -151,6 +151,11 @@ pub enum Set {
     /// play radii on the play base).
     Fresh34,
     Fresh35,
+    /// The thirty-seventh and thirty-eighth, first run for the tenth report of 2026-11-28
+    /// (tanh's global search also starts from a grid of its rate gain and width, the rest by
+    /// least squares).
+    Fresh36,
+    Fresh37,
 }
 
 impl Set {
@@ -193,6 +198,8 @@ impl Set {
         ("fresh33", Set::Fresh33),
         ("fresh34", Set::Fresh34),
         ("fresh35", Set::Fresh35),
+        ("fresh36", Set::Fresh36),
+        ("fresh37", Set::Fresh37),
     ];
 
     /// The seed of case `k` of this set.
@@ -235,6 +242,8 @@ impl Set {
             Set::Fresh33 => 308_000_000 + 157 * k,
             Set::Fresh34 => 324_000_000 + 163 * k,
             Set::Fresh35 => 342_000_000 + 167 * k,
+            Set::Fresh36 => 360_000_000 + 173 * k,
+            Set::Fresh37 => 378_000_000 + 179 * k,
         }
     }
 }
