@@ -15,7 +15,6 @@
 
 use rayon::prelude::*;
 
-use super::global::Candidate;
 use super::objective::Objective;
 use crate::numerics::lstsq;
 
@@ -27,10 +26,17 @@ const POINTS_1D: usize = 24;
 /// Relative singular-value cut-off of the least-squares solve.
 const RCOND: f64 = 1e-10;
 
+/// A grid point: the model's full parameter vector and its cost on the objective.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridPoint {
+    pub params: Vec<f64>,
+    pub cost: f64,
+}
+
 /// The `keep` best grid points of `obj` (distinct grid cells), each with its affine
 /// parameters solved and clamped to their box, best first; empty when the model has no
 /// affine parameter free or more than [`MAX_GRID_DIMS`] others.
-pub fn starts(obj: &Objective<'_>, affine: &[&str], keep: usize) -> Vec<Candidate> {
+pub fn starts(obj: &Objective<'_>, affine: &[&str], keep: usize) -> Vec<GridPoint> {
     let n_model = obj.sim.n_params();
     let sp = obj.spec;
     let free: Vec<usize> = obj.free.iter().copied().filter(|&j| j < n_model).collect();
@@ -40,7 +46,7 @@ pub fn starts(obj: &Objective<'_>, affine: &[&str], keep: usize) -> Vec<Candidat
         return Vec::new();
     }
     let points = cells(grid.len());
-    let mut found: Vec<Candidate> = points
+    let mut found: Vec<GridPoint> = points
         .par_iter()
         .filter_map(|unit| {
             let mut p = sp.start();
@@ -50,19 +56,19 @@ pub fn starts(obj: &Objective<'_>, affine: &[&str], keep: usize) -> Vec<Candidat
             }
             let p = solve_affine(obj, p, &lin)?;
             let cost = obj.cost(&p);
-            cost.is_finite().then_some(Candidate { params: p, cost })
+            cost.is_finite().then_some(GridPoint { params: p, cost })
         })
         .collect();
     found.sort_by(|a, b| a.cost.total_cmp(&b.cost));
     // One point per neighbourhood of grid cells: the next best elsewhere, not a neighbour.
-    let cell = |c: &Candidate| -> Vec<f64> {
+    let cell = |c: &GridPoint| -> Vec<f64> {
         grid.iter().filter_map(|&j| Some(sp.params.get(j)?.to_unit(*c.params.get(j)?))).collect()
     };
     let widths: Vec<f64> = grid_sizes(grid.len()).iter().map(|&n| 1.5 / n as f64).collect();
-    let mut kept: Vec<Candidate> = Vec::new();
+    let mut kept: Vec<GridPoint> = Vec::new();
     for c in found {
         let u = cell(&c);
-        let near = |k: &Candidate| cell(k).iter().zip(&u).zip(&widths).all(|((a, b), w)| (a - b).abs() < *w);
+        let near = |k: &GridPoint| cell(k).iter().zip(&u).zip(&widths).all(|((a, b), w)| (a - b).abs() < *w);
         if !kept.iter().any(near) {
             kept.push(c);
         }
