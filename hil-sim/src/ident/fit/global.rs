@@ -172,6 +172,7 @@ pub(super) fn global_search(
         lm::LocalFit { cost: full.cost(&r.params), evaluations: r.evaluations + 1, ..r }
     };
     let mut polished: Vec<lm::LocalFit> = cands.par_iter().map(|c| polish(&c.params)).collect();
+    let swarm_evals = polished.iter().map(|r| r.evaluations).sum::<usize>();
     let mut fixed_evals = 0;
     let done = fixed.polished.get_or_init(|| {
         let r: Vec<lm::LocalFit> = fixed.starts.par_iter().map(|p| polish(p)).collect();
@@ -179,9 +180,7 @@ pub(super) fn global_search(
         r
     });
     polished.extend(done.iter().cloned());
-    let evals = swarm.particles * (swarm.iterations as usize + 1)
-        + fixed_evals
-        + polished.iter().take(cands.len()).map(|r| r.evaluations).sum::<usize>();
+    let evals = swarm.particles * (swarm.iterations as usize + 1) + swarm_evals + fixed_evals;
     let best = polished.into_iter().filter(|r| r.cost.is_finite()).min_by(|a, b| a.cost.total_cmp(&b.cost));
     Ok((best, evals, found))
 }

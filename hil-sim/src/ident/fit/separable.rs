@@ -65,18 +65,18 @@ pub fn starts(obj: &Objective<'_>, affine: &[&str], keep: usize) -> Vec<GridPoin
         grid.iter().filter_map(|&j| Some(sp.params.get(j)?.to_unit(*c.params.get(j)?))).collect()
     };
     let widths: Vec<f64> = grid_sizes(grid.len()).iter().map(|&n| 1.5 / n as f64).collect();
-    let mut kept: Vec<GridPoint> = Vec::new();
+    let mut kept: Vec<(Vec<f64>, GridPoint)> = Vec::new();
     for c in found {
         let u = cell(&c);
-        let near = |k: &GridPoint| cell(k).iter().zip(&u).zip(&widths).all(|((a, b), w)| (a - b).abs() < *w);
+        let near = |(k, _): &(Vec<f64>, GridPoint)| k.iter().zip(&u).zip(&widths).all(|((a, b), w)| (a - b).abs() < *w);
         if !kept.iter().any(near) {
-            kept.push(c);
+            kept.push((u, c));
         }
         if kept.len() >= keep {
             break;
         }
     }
-    kept
+    kept.into_iter().map(|(_, c)| c).collect()
 }
 
 fn grid_sizes(dims: usize) -> Vec<usize> {
