@@ -337,7 +337,7 @@ impl<'a> Problem<'a> {
     }
 
     /// The recorded input through `transforms`.
-    fn transformed(&self, transforms: &[Transform]) -> Vec<f64> {
+    pub(super) fn transformed(&self, transforms: &[Transform]) -> Vec<f64> {
         let mut x = self.data.input.clone();
         for t in transforms {
             x = t.apply(&x, self.data.dt);
@@ -347,7 +347,7 @@ impl<'a> Problem<'a> {
 
     /// `terms` with the maps of the input made again from the recorded input through the
     /// `transforms` each follows ([`InputMap::follows`]; `x`: through all of them).
-    fn through(&self, mut terms: Vec<Term>, transforms: &[Transform], x: &[f64]) -> Vec<Term> {
+    pub(super) fn through(&self, mut terms: Vec<Term>, transforms: &[Transform], x: &[f64]) -> Vec<Term> {
         for t in &mut terms {
             let Some((map, recorded)) = &t.of_input else { continue };
             t.values = if !transforms.iter().any(|tr| map.follows(tr)) {
@@ -367,7 +367,7 @@ impl<'a> Problem<'a> {
     }
 
     /// The base model's kinematics for the (transformed) input `x`.
-    fn kin_of(&self, x: &[f64]) -> Option<Vec<model_core::Kin>> {
+    pub(super) fn kin_of(&self, x: &[f64]) -> Option<Vec<model_core::Kin>> {
         // Given rates are the zero-phase ones: recomputed for the transformed input.
         let rates = self
             .data
@@ -378,7 +378,7 @@ impl<'a> Problem<'a> {
         kinematics(&samples, self.data.dt as f32, self.rate)
     }
 
-    fn run_kin(&self, theta: &[f64], kin: &[model_core::Kin]) -> Option<Vec<f64>> {
+    pub(super) fn run_kin(&self, theta: &[f64], kin: &[model_core::Kin]) -> Option<Vec<f64>> {
         let mut out = vec![0.0; kin.len()];
         self.sim.run(theta, kin, &mut out).then_some(out)
     }

@@ -19,7 +19,9 @@
 //!    nonlinear value (a time constant, a delay, a saturation level, an offset, a channel
 //!    lag) scanned on a grid with the base model's Jacobian standing in for its refit (an
 //!    input transform's grid profiled by short refits instead), then the term refitted
-//!    jointly with the base parameters ([`augment`]). Candidates are ranked by the
+//!    jointly with the base parameters ([`augment`]); on a base affine in some of its
+//!    parameters (tanh), an additive term's refit also starts where base and term fit best
+//!    together on the base's grid ([`joint_grid`]). Candidates are ranked by the
 //!    Bayesian information criterion on the training part.
 //! 4. **Model** ([`accept`]). Of the candidates whose held-out gain passes the paired block
 //!    test ([`significance`]), the one that predicts the held-out part best is kept; one the
@@ -40,6 +42,7 @@ pub mod contenders;
 pub mod decimate;
 pub mod describe;
 pub mod diagnosis;
+pub mod joint_grid;
 pub mod lag_or_delay;
 pub mod leak;
 pub mod level_map;

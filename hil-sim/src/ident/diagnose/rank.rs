@@ -99,12 +99,17 @@ fn scored_on(prob: &Problem<'_>, cands: &[Candidate], reference: &Fitted, used: 
     let jac = prob.jacobian_at(&reference.theta, &reference.transforms)?;
     let bic = |f: &Fitted| bic(prob.train.len(), f);
     let bic_ref = bic(reference);
+    let joint = super::joint_grid::starts(prob, cands, reference, used);
     let mut scored: Vec<Scored> = cands
         .par_iter()
         .enumerate()
         .filter(|(k, _)| !used.contains(k))
         .filter_map(|(k, c)| {
-            let starts = starts_on_grid(prob, c, reference, &jac);
+            let mut starts = starts_on_grid(prob, c, reference, &jac);
+            // On an affine base, also from the joint optimum of the base and the term.
+            if let (Some(theta), Some(&g)) = (joint.get(k).cloned().flatten(), c.grid.first()) {
+                starts.push((g, Some(theta)));
+            }
             let (f, g) = refit_candidate(prob, c, reference, &starts, SCREEN_ITERATIONS)?;
             let bic_gain = bic_ref - bic(&f);
             Some(Scored { index: k, fitted: f, bic_gain, value: g })

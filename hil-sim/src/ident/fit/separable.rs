@@ -16,6 +16,7 @@
 use rayon::prelude::*;
 
 use super::objective::Objective;
+use crate::models::search::ModelSpec;
 use crate::numerics::lstsq;
 
 /// Most non-affine free parameters put on a grid.
@@ -40,21 +41,15 @@ pub fn starts(obj: &Objective<'_>, affine: &[&str], keep: usize) -> Vec<GridPoin
     let n_model = obj.sim.n_params();
     let sp = obj.spec;
     let free: Vec<usize> = obj.free.iter().copied().filter(|&j| j < n_model).collect();
-    let (lin, grid): (Vec<usize>, Vec<usize>) =
-        free.iter().partition(|&&j| sp.params.get(j).is_some_and(|p| affine.contains(&p.name)));
-    if lin.is_empty() || grid.is_empty() || grid.len() > MAX_GRID_DIMS || keep == 0 {
+    let Some(grid) = Grid::of(sp, &free, affine, &sp.start()) else { return Vec::new() };
+    if keep == 0 {
         return Vec::new();
     }
-    let points = cells(grid.len());
-    let mut found: Vec<GridPoint> = points
+    let mut found: Vec<GridPoint> = grid
+        .points
         .par_iter()
-        .filter_map(|unit| {
-            let mut p = sp.start();
-            for (&j, &u) in grid.iter().zip(unit) {
-                let v = sp.params.get(j)?.from_unit(u);
-                *p.get_mut(j)? = v;
-            }
-            let p = solve_affine(obj, p, &lin)?;
+        .filter_map(|p| {
+            let p = solve_affine(obj, p.clone(), &grid.lin)?;
             let cost = obj.cost(&p);
             cost.is_finite().then_some(GridPoint { params: p, cost })
         })
@@ -62,9 +57,9 @@ pub fn starts(obj: &Objective<'_>, affine: &[&str], keep: usize) -> Vec<GridPoin
     found.sort_by(|a, b| a.cost.total_cmp(&b.cost));
     // One point per neighbourhood of grid cells: the next best elsewhere, not a neighbour.
     let cell = |c: &GridPoint| -> Vec<f64> {
-        grid.iter().filter_map(|&j| Some(sp.params.get(j)?.to_unit(*c.params.get(j)?))).collect()
+        grid.dims.iter().filter_map(|&j| Some(sp.params.get(j)?.to_unit(*c.params.get(j)?))).collect()
     };
-    let widths: Vec<f64> = grid_sizes(grid.len()).iter().map(|&n| 1.5 / n as f64).collect();
+    let widths: Vec<f64> = grid_sizes(grid.dims.len()).iter().map(|&n| 1.5 / n as f64).collect();
     let mut kept: Vec<(Vec<f64>, GridPoint)> = Vec::new();
     for c in found {
         let u = cell(&c);
@@ -77,6 +72,62 @@ pub fn starts(obj: &Objective<'_>, affine: &[&str], keep: usize) -> Vec<GridPoin
         }
     }
     kept.into_iter().map(|(_, c)| c).collect()
+}
+
+/// The grid of a model with affine parameters: which free parameters are affine (`lin`),
+/// which are put on the grid (`dims`), and the full parameter vector at every grid point
+/// (the others as in the base vector it was made from).
+pub struct Grid {
+    pub lin: Vec<usize>,
+    pub dims: Vec<usize>,
+    pub points: Vec<Vec<f64>>,
+}
+
+impl Grid {
+    /// The grid over the free parameters `free` of `sp` that are not in `affine`, about
+    /// `base`; `None` when none of `free` is affine, or none or more than
+    /// [`MAX_GRID_DIMS`] are not.
+    pub fn of(sp: &ModelSpec, free: &[usize], affine: &[&str], base: &[f64]) -> Option<Grid> {
+        let (lin, dims): (Vec<usize>, Vec<usize>) =
+            free.iter().partition(|&&j| sp.params.get(j).is_some_and(|p| affine.contains(&p.name)));
+        if lin.is_empty() || dims.is_empty() || dims.len() > MAX_GRID_DIMS {
+            return None;
+        }
+        let points = cells(dims.len())
+            .into_iter()
+            .filter_map(|unit| {
+                let mut p = base.to_vec();
+                for (&j, &u) in dims.iter().zip(&unit) {
+                    *p.get_mut(j)? = sp.params.get(j)?.from_unit(u);
+                }
+                Some(p)
+            })
+            .collect();
+        Some(Grid { lin, dims, points })
+    }
+}
+
+/// The output with the affine parameters `lin` of `p` all at 0, and each one's column (the
+/// output with it at 1 and the others at 0, less that); `run` runs the model. `None` when
+/// the model rejects a vector.
+pub fn affine_columns(
+    run: impl Fn(&[f64]) -> Option<Vec<f64>>,
+    p: &[f64],
+    lin: &[usize],
+) -> Option<(Vec<f64>, Vec<Vec<f64>>)> {
+    let mut p = p.to_vec();
+    for &j in lin {
+        *p.get_mut(j)? = 0.0;
+    }
+    let zero = run(&p)?;
+    let mut cols = Vec::with_capacity(lin.len());
+    for &j in lin {
+        let mut q = p.clone();
+        *q.get_mut(j)? = 1.0;
+        let out = run(&q)?;
+        cols.push(out.iter().zip(&zero).map(|(a, b)| a - b).collect::<Vec<f64>>());
+    }
+    Some((zero, cols))
 }
 
 fn grid_sizes(dims: usize) -> Vec<usize> {
@@ -114,26 +165,25 @@ fn solve_affine(obj: &Objective<'_>, mut p: Vec<f64>, lin: &[usize]) -> Option<V
         let mut out = vec![0.0; obj.end];
         obj.sim.run(q.get(..n)?, kin, &mut out).then_some(out)
     };
-    for &j in lin {
-        *p.get_mut(j)? = 0.0;
-    }
-    let zero = run(&p)?;
-    let mut cols = Vec::with_capacity(lin.len());
-    for &j in lin {
-        let mut q = p.clone();
-        *q.get_mut(j)? = 1.0;
-        let out = run(&q)?;
-        cols.push(out.iter().zip(&zero).map(|(a, b)| a - b).collect::<Vec<f64>>());
-    }
+    let (zero, cols) = affine_columns(run, &p, lin)?;
     let target: Vec<f64> = obj.y.iter().take(obj.end).zip(&zero).map(|(y, z)| y - z).collect();
     let (g, b) = lstsq::normal_equations(&cols, &target, obj.rows);
     let theta = lstsq::solve_scaled(g, b, RCOND)?;
-    for (k, &j) in lin.iter().enumerate() {
-        let ps = obj.spec.params.get(j)?;
-        let v = theta.get(k).copied().filter(|v| v.is_finite())?;
+    set_clamped(obj.spec, &mut p, lin, theta.as_slice())?;
+    Some(p)
+}
+
+/// `p` with the affine parameters `lin` set to `values`, each clamped to its box; `None`
+/// when a value is not finite.
+pub fn set_clamped(sp: &ModelSpec, p: &mut [f64], lin: &[usize], values: &[f64]) -> Option<()> {
+    for (&j, &v) in lin.iter().zip(values) {
+        let ps = sp.params.get(j)?;
+        if !v.is_finite() {
+            return None;
+        }
         *p.get_mut(j)? = v.clamp(ps.lo, ps.hi);
     }
-    Some(p)
+    Some(())
 }
 
 #[cfg(test)]

@@ -156,6 +156,11 @@ pub enum Set {
     /// least squares).
     Fresh36,
     Fresh37,
+    /// The thirty-ninth and fortieth, first run for the eleventh report of 2026-11-28 (an
+    /// additive candidate on a tanh base also refitted from the grid point where base and
+    /// term fit best together).
+    Fresh38,
+    Fresh39,
 }
 
 impl Set {
@@ -200,6 +205,8 @@ impl Set {
         ("fresh35", Set::Fresh35),
         ("fresh36", Set::Fresh36),
         ("fresh37", Set::Fresh37),
+        ("fresh38", Set::Fresh38),
+        ("fresh39", Set::Fresh39),
     ];
 
     /// The seed of case `k` of this set.
@@ -244,6 +251,8 @@ impl Set {
             Set::Fresh35 => 342_000_000 + 167 * k,
             Set::Fresh36 => 360_000_000 + 173 * k,
             Set::Fresh37 => 378_000_000 + 179 * k,
+            Set::Fresh38 => 396_000_000 + 181 * k,
+            Set::Fresh39 => 416_000_000 + 191 * k,
         }
     }
 }
