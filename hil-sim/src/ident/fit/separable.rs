@@ -3,7 +3,9 @@
 //! affine in `α, c, k, T₀` for fixed `β, γ`): the other free parameters (at most
 //! [`MAX_GRID_DIMS`]) on a grid over their box, the affine ones solved by least squares at
 //! each grid point (variable projection), and the best few points handed to the global
-//! phase's polish ([`super::global`]).
+//! phase's polish ([`super::global`]). The grid ([`Grid`]) and the affine columns
+//! ([`affine_columns`]) also serve `diagnose`, which solves the same grid with a candidate
+//! term's weight beside the affine parameters (`ident::diagnose::joint_grid`).
 //!
 //! The swarm searches every parameter at once and can settle in a basin of tanh's rate gain
 //! `β` far from the data's (a Bingham-type clutch, `τ₀·tanh(ḃ/ε)` on a power-law static
