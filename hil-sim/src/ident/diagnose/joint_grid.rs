@@ -138,10 +138,23 @@ pub fn best_points(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ident::fit::simulate::simulator;
+    use crate::ident::diagnose::tests::with_noise;
+    use crate::ident::fit::simulate::{simulator, Simulator};
     use crate::ident::fit::Dataset;
+    use crate::models::search::ModelSpec;
     use crate::models::RateSpec;
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
+
+    /// tanh's search space on `data`'s scales.
+    fn spec_of(data: &Dataset) -> ModelSpec {
+        crate::models::host("tanh").unwrap().spec(&data.scales(), None).unwrap()
+    }
+
+    /// The refit problem of `sim` on `data`, trained on its training part.
+    fn problem<'a>(data: &'a Dataset, sim: &'a dyn Simulator, spec: &'a ModelSpec) -> Problem<'a> {
+        let train = (0..data.train_end).collect();
+        Problem { data, sim, spec, rate: RateSpec::Backward, train, rate_cutoff_hz: 100.0 }
+    }
 
     /// A tanh clutch (seed 000 eq. 11) with a `|ḃ|·ḃ` term at 5 % of its span, under two
     /// tones, and a reference whose rate gain sits 30 times off the truth's (a base that
@@ -157,51 +170,24 @@ mod tests {
                 0.4 * (2.0 * std::f64::consts::PI * 3.0 * t).sin() + 0.2 * (2.0 * std::f64::consts::PI * 7.7 * t).sin()
             })
             .collect();
-        let mut data = Dataset {
-            dt,
-            time: (0..n).map(|i| i as f64 * dt).collect(),
-            input: x.clone(),
-            output: vec![0.0; n],
-            command: None,
-            train_end: n * 7 / 10,
-            excluded: vec![false; n],
-            unusable: Vec::new(),
-            rates: None,
-            runs: Vec::new(),
-        };
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
         let sim = simulator("tanh", dt as f32).unwrap();
         let truth = [0.8, 0.3, 0.0, 0.01, 3.0, 0.1];
         let kin = {
-            let spec = crate::models::host("tanh").unwrap().spec(&data.scales(), None).unwrap();
-            let prob = Problem {
-                data: &data,
-                sim: sim.as_ref(),
-                spec: &spec,
-                rate: RateSpec::Backward,
-                train: Vec::new(),
-                rate_cutoff_hz: 100.0,
-            };
-            prob.kin_of(&x).unwrap()
+            let blank = with_noise(x.clone(), &vec![0.0; n], &mut rng);
+            let spec = spec_of(&blank);
+            problem(&blank, sim.as_ref(), &spec).kin_of(&x).unwrap()
         };
         let mut y = vec![0.0; n];
         assert!(sim.run(&truth, &kin, &mut y));
-        let rate: Vec<f64> = kin.iter().map(|k| f64::from(k.dx)).collect();
-        let term: Vec<f64> = rate.iter().map(|v| v.abs() * v).collect();
+        let term: Vec<f64> = kin.iter().map(|k| f64::from(k.dx) * f64::from(k.dx).abs()).collect();
         let (lo, hi) = crate::numerics::stats::min_max(&y);
         let (t_lo, t_hi) = crate::numerics::stats::min_max(&term);
         let w = 0.05 * (hi - lo) / (t_hi - t_lo);
-        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
-        data.output =
-            y.iter().zip(&term).map(|(y, t)| y + w * t + 0.002 * (hi - lo) * (rng.random::<f64>() - 0.5)).collect();
-        let spec = crate::models::host("tanh").unwrap().spec(&data.scales(), None).unwrap();
-        let prob = Problem {
-            data: &data,
-            sim: sim.as_ref(),
-            spec: &spec,
-            rate: RateSpec::Backward,
-            train: (0..data.train_end).collect(),
-            rate_cutoff_hz: 100.0,
-        };
+        let with_term: Vec<f64> = y.iter().zip(&term).map(|(y, t)| y + w * t).collect();
+        let data = with_noise(x, &with_term, &mut rng);
+        let spec = spec_of(&data);
+        let prob = problem(&data, sim.as_ref(), &spec);
         let mut off = truth;
         off[1] *= 30.0;
         let reference = prob.refit(&[], &[], None, &off, 0).unwrap().0;
@@ -212,7 +198,7 @@ mod tests {
             grid: vec![0.0],
             build: Box::new(move |_| super::super::candidates::Piece {
                 transform: None,
-                terms: vec![super::super::augment::Term::additive("c_rate", term.clone())],
+                terms: vec![Term::additive("c_rate", term.clone())],
             }),
             channel: None,
         }];
