@@ -6,9 +6,10 @@
 //!
 //! The base fit's grid finds the lowest training error of the base alone; with a concealed
 //! rate term, tanh's rate gain bends to take it up (`tanh(β·ḃ)` holds a cubic), and a refit
-//! of the term started there stays in that basin (a Kwok clutch with a `|ḃ|·ḃ` term:
-//! held-out 0.76 % with or without the term, 0.40 % from another basin with it). The
-//! candidate's own grid start puts the base and the term at their joint optimum.
+//! of the term started there stays in that basin (the bench's fresh34 `324029177`, a
+//! `|ḃ|·ḃ` term on a Bingham-type clutch, and fresh35 `342013861`, on a Kwok clutch, were
+//! named nothing). The candidate's own grid start puts the base and the term at their
+//! joint optimum.
 
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -47,11 +48,7 @@ pub fn starts(prob: &Problem<'_>, cands: &[Candidate], reference: &Fitted, used:
 /// training rows best: its sum of squared errors (on at most [`MAX_ROWS`] of the rows) and
 /// the base parameters θ there; all `None` when the base has no affine parameter or the
 /// reference a term that is not additive.
-pub fn best_points(
-    prob: &Problem<'_>,
-    reference: &Fitted,
-    pieces: &[Option<Vec<Term>>],
-) -> Vec<Option<(f64, Vec<f64>)>> {
+pub fn best_points(prob: &Problem<'_>, reference: &Fitted, pieces: &[Option<Vec<Term>>]) -> Vec<Solved> {
     let none = vec![None; pieces.len()];
     let affine = crate::models::host(prob.spec.id).map_or(&[][..], |h| h.affine);
     let additive = |t: &Term| matches!(t.kind, TermKind::Additive);
