@@ -236,6 +236,14 @@ fn reported(set: Set, seed: u64) -> Case {
     cases(set, 200, 40).into_iter().find(|c| c.seed == seed).expect("the case")
 }
 
+/// Each of `cases` (set and seed, as reported) diagnosed right.
+fn each_right(cases: impl IntoIterator<Item = (Set, u64)>) {
+    for (set, seed) in cases {
+        let o = run(&reported(set, seed));
+        assert!(o.right(), "{}", line(&o));
+    }
+}
+
 /// Four nulls (fresh21 `145701067`, fresh22 `156100606` and `156102424`, fresh26 `213301017`:
 /// development since their reports) on which a term gained 7–9 % of the held-out RMSE,
 /// significant on the blocks, and was named: a finding needs 10 %
@@ -248,11 +256,7 @@ fn a_term_gaining_under_ten_percent_is_no_finding_on_a_null() {
         (Set::Fresh22, 156_102_424),
         (Set::Fresh26, 213_301_017),
     ];
-    for (set, seed) in nulls {
-        let c = reported(set, seed);
-        let o = run(&c);
-        assert!(o.right(), "{}", line(&o));
-    }
+    each_right(nulls);
 }
 
 /// Seed 000 fits the clutch with a Bouc–Wen loop of exponent `n = 1`; the base was fitted
@@ -303,11 +307,7 @@ fn a_tanh_loop_far_from_the_swarm_start_is_found_by_the_grid() {
         (Set::Fresh35, 342_025_885),
         (Set::Fresh35, 342_009_853),
     ];
-    for (set, seed) in cases {
-        let c = reported(set, seed);
-        let o = run(&c);
-        assert!(o.right(), "{}", line(&o));
-    }
+    each_right(cases);
 }
 
 /// With tanh's grid its fit bends its rate gain to take up a concealed rate term; an additive
@@ -318,11 +318,7 @@ fn a_tanh_loop_far_from_the_swarm_start_is_found_by_the_grid() {
 #[test]
 fn a_rate_term_on_a_tanh_base_is_refitted_from_the_joint_grid() {
     let cases = [(Set::Fresh34, 324_029_177), (Set::Fresh35, 342_013_861), (Set::Fresh36, 377_305_882)];
-    for (set, seed) in cases {
-        let c = reported(set, seed);
-        let o = run(&c);
-        assert!(o.right(), "{}", line(&o));
-    }
+    each_right(cases);
 }
 
 #[test]

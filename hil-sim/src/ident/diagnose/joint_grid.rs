@@ -48,7 +48,7 @@ pub fn starts(prob: &Problem<'_>, cands: &[Candidate], reference: &Fitted, used:
 /// training rows best: its sum of squared errors (on at most [`MAX_ROWS`] of the rows) and
 /// the base parameters θ there; all `None` when the base has no affine parameter or the
 /// reference a term that is not additive.
-pub fn best_points(prob: &Problem<'_>, reference: &Fitted, pieces: &[Option<Vec<Term>>]) -> Vec<Solved> {
+fn best_points(prob: &Problem<'_>, reference: &Fitted, pieces: &[Option<Vec<Term>>]) -> Vec<Solved> {
     let none = vec![None; pieces.len()];
     let affine = crate::models::host(prob.spec.id).map_or(&[][..], |h| h.affine);
     let additive = |t: &Term| matches!(t.kind, TermKind::Additive);
@@ -84,7 +84,7 @@ pub fn best_points(prob: &Problem<'_>, reference: &Fitted, pieces: &[Option<Vec<
     let fixed: Vec<&[f64]> = reference.terms.iter().map(|t| t.values.as_slice()).collect();
     let piece_cols: Vec<&[f64]> = columns.iter().map(Vec::as_slice).collect();
     let (c_mat, y) = (matrix(&piece_cols), on_rows(&prob.data.output));
-    let (g_cc, c_y) = (c_mat.tr_mul(&c_mat), c_mat.tr_mul(&y));
+    let g_cc = c_mat.tr_mul(&c_mat);
     let run = |q: &[f64]| prob.run_kin(q, &kin);
     // At each grid point, every piece's training SSE and solved affine values.
     let per_point: Vec<(usize, Vec<Solved>)> = grid
@@ -96,8 +96,7 @@ pub fn best_points(prob: &Problem<'_>, reference: &Fitted, pieces: &[Option<Vec<
             let a_cols: Vec<&[f64]> = lin_cols.iter().map(Vec::as_slice).chain(fixed.iter().copied()).collect();
             let a = matrix(&a_cols);
             let t = &y - on_rows(&zero);
-            let (g_aa, g_ac, a_t) = (a.tr_mul(&a), a.tr_mul(&c_mat), a.tr_mul(&t));
-            let c_t = &c_y - c_mat.tr_mul(&on_rows(&zero));
+            let (g_aa, g_ac, a_t, c_t) = (a.tr_mul(&a), a.tr_mul(&c_mat), a.tr_mul(&t), c_mat.tr_mul(&t));
             let tt = t.dot(&t);
             let solved = of_piece
                 .iter()
