@@ -14,8 +14,17 @@ pub struct QualityConfig {
     pub clip_dwell: f64,
     /// or stays within 3σ of the extreme for at least this many T½ and
     pub clip_flat: f64,
-    /// at least this many samples.
+    /// at least this many samples;
     pub clip_flat_samples: usize,
+    /// and in either case the episode's longest hump (its visits with the channel staying
+    /// within twice the band of the extreme between them) is flat: a parabola fitted to it
+    /// (first to last visit) falls from its top to its lower end at most this share of how
+    /// deep into the band that top reaches. A free peak traces its own curve, which falls
+    /// from its top back to the band's edge, whether it reaches the extreme or grazes the band; a slow
+    /// peak (a swept sine's first cycles, a 1 Hz block among faster ones) stays in the band
+    /// for many of the recording's median T½, and a block of fast peaks at full amplitude
+    /// merges into one long episode of many humps.
+    pub clip_curved: f64,
     /// Standstill: the input stays within this fraction of its span
     pub standstill_band: f64,
     /// for at least this long (s) and at least `standstill_half_periods` T½.
@@ -48,6 +57,7 @@ impl Default for QualityConfig {
             clip_dwell: 1.0,
             clip_flat: 0.1,
             clip_flat_samples: 10,
+            clip_curved: 0.5,
             standstill_band: 0.01,
             standstill_min_s: 0.5,
             standstill_half_periods: 4.0,

@@ -161,6 +161,11 @@ pub enum Set {
     /// term fit best together).
     Fresh38,
     Fresh39,
+    /// The forty-first and forty-second, first run for the twelfth report of 2026-11-29 (the
+    /// quality check no longer calls a free peak clipped: a slow peak's or a block of full
+    /// peaks' samples stay in the fit).
+    Fresh40,
+    Fresh41,
 }
 
 impl Set {
@@ -207,6 +212,8 @@ impl Set {
         ("fresh37", Set::Fresh37),
         ("fresh38", Set::Fresh38),
         ("fresh39", Set::Fresh39),
+        ("fresh40", Set::Fresh40),
+        ("fresh41", Set::Fresh41),
     ];
 
     /// The seed of case `k` of this set.
@@ -253,6 +260,8 @@ impl Set {
             Set::Fresh37 => 378_000_000 + 179 * k,
             Set::Fresh38 => 396_000_000 + 181 * k,
             Set::Fresh39 => 416_000_000 + 191 * k,
+            Set::Fresh40 => 436_000_000 + 193 * k,
+            Set::Fresh41 => 458_000_000 + 197 * k,
         }
     }
 }
