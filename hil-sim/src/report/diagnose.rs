@@ -25,14 +25,25 @@ pub fn section(rep: &mut Report, dir: &Path, stem: &str, d: &Diagnosis, names: (
     let out_unit = unit_of(names.1).unwrap_or("");
     let unit = |n: &str| unit_of(n).map(|u| format!(" ({u})")).unwrap_or_default();
     let yl = format!("{}{}", names.1, unit(names.1));
+    let (b, r) = (&d.base_heldout, &d.reference_heldout);
+    // The fit alone and the reference the candidates were judged against, when they differ.
+    let reference = if format!("{:.2}", 100.0 * r.r_rmse) != format!("{:.2}", 100.0 * b.r_rmse) {
+        format!(
+            "; refitted until it stalls, the reference every candidate is judged against: R-RMSE {:.2} %, R² {:.4}",
+            100.0 * r.r_rmse,
+            r.r2
+        )
+    } else {
+        String::new()
+    };
     rep.paragraph(&format!(
         "Base model **{}** (fitted on the first {:.0} % with the channels as recorded), held-out R-RMSE {:.2} %, \
-         R² {:.4}; with every finding's term: R-RMSE {:.2} %, R² {:.4}. Residual noise floor {} (RMS); \
+         R² {:.4}{reference}; with every finding's term: R-RMSE {:.2} %, R² {:.4}. Residual noise floor {} (RMS); \
          diagnosed in {}.",
         d.base_model,
         100.0 * (1.0 - d.heldout_fraction),
-        100.0 * d.base_heldout.r_rmse,
-        d.base_heldout.r2,
+        100.0 * b.r_rmse,
+        b.r2,
         100.0 * d.final_heldout.r_rmse,
         d.final_heldout.r2,
         with_unit(d.locate.noise_rms, 4, out_unit),

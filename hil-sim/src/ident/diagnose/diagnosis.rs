@@ -105,7 +105,12 @@ pub struct Diagnosis {
     pub findings: Vec<Finding>,
     /// The base model as fitted, held-out part.
     pub base_heldout: Metrics,
-    /// The model with every finding's term, held-out part.
+    /// The base model as the first round's candidates were judged against it, held-out part:
+    /// refitted from the fit until it stalls (further when a candidate's refit found better
+    /// base parameters), with its play operators and its level term when it has them.
+    pub reference_heldout: Metrics,
+    /// The model the diagnosis ends with (the reference with every finding's term), held-out
+    /// part; the reference's when nothing was found.
     pub final_heldout: Metrics,
     /// Base models tried by `auto`, with their held-out R-RMSE.
     pub bases_tried: Vec<(String, f64)>,

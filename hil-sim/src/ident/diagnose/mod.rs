@@ -150,6 +150,9 @@ fn diagnose_at_rate(
     let id = base.fit.model.clone();
     let judge = Judge { noise_rms: located.noise_rms, ..judge0 };
     let base_heldout = judge.heldout(&before);
+    // What the first round judged every candidate against (its reference, refitted further
+    // than `current` when a candidate's refit found better base parameters).
+    let reference_heldout = first.as_ref().map_or_else(|| judge.heldout(&current.pred), |(_, v)| v.before);
     // 3–4. Name and model, round by round.
     let diverges = || DiagnoseError::Diverges(id.clone());
     let (mut findings, mut tested, mut used) = (Vec::new(), Vec::new(), Vec::<usize>::new());
@@ -204,13 +207,14 @@ fn diagnose_at_rate(
         used.extend((0..cands.len()).filter(|&j| cands[j].effect == c.effect && cands[j].channel == c.channel));
         current = kept.scored.fitted;
     }
-    let unchanged = current.transforms.is_empty() && current.terms.is_empty();
+    let final_heldout = if findings.is_empty() { reference_heldout } else { judge.heldout(&current.pred) };
     Ok(Diagnosis {
         base_model: id,
         heldout_fraction: opts.heldout,
         findings,
         base_heldout,
-        final_heldout: if unchanged { base_heldout } else { judge.heldout(&current.pred) },
+        reference_heldout,
+        final_heldout,
         bases_tried: fitted.tried,
         locate: located,
         channels,
@@ -528,5 +532,15 @@ mod tests {
         let d = run(&recording(None, 2));
         assert!(d.findings.is_empty(), "{:#?}", d.findings);
         assert!(!d.candidates.is_empty(), "every candidate is still tested");
+        // The header's reference is what round 1's candidates were judged against, and with
+        // nothing found the diagnosis ends with it (not with the fit alone).
+        let judged = d.candidates.iter().map(|c| c.heldout_r_rmse_before);
+        assert!(
+            judged.clone().all(|b| b == d.reference_heldout.r_rmse),
+            "{:?} {:?}",
+            d.reference_heldout,
+            judged.collect::<Vec<_>>()
+        );
+        assert_eq!(d.final_heldout.r_rmse, d.reference_heldout.r_rmse);
     }
 }
