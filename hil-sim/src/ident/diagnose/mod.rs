@@ -150,8 +150,6 @@ fn diagnose_at_rate(
     let id = base.fit.model.clone();
     let judge = Judge { noise_rms: located.noise_rms, ..judge0 };
     let base_heldout = judge.heldout(&before);
-    // What the first round judged every candidate against (its reference, refitted further
-    // than `current` when a candidate's refit found better base parameters).
     let reference_heldout = first.as_ref().map_or_else(|| judge.heldout(&current.pred), |(_, v)| v.before);
     // 3–4. Name and model, round by round.
     let diverges = || DiagnoseError::Diverges(id.clone());
