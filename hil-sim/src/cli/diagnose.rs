@@ -145,17 +145,15 @@ pub fn run(a: DiagnoseArgs) -> anyhow::Result<()> {
 /// The diagnosis in words.
 pub fn text(d: &Diagnosis) -> String {
     let unit = if d.units.1.is_empty() { "(output units)" } else { d.units.1.as_str() };
-    let (b, r) = (&d.base_heldout, &d.reference_heldout);
+    let b = &d.base_heldout;
     // The fit alone and the reference the candidates were judged against, when they differ.
-    let reference = if format!("{:.2}", 100.0 * r.r_rmse) != format!("{:.2}", 100.0 * b.r_rmse) {
+    let reference = d.reference_apart().map_or_else(String::new, |r| {
         format!(
             "; refitted until it stalls (the reference every candidate is judged against) {:.2} %, R² {:.4}",
             100.0 * r.r_rmse,
             r.r2
         )
-    } else {
-        String::new()
-    };
+    });
     let mut s = format!(
         "base model {}: held-out R-RMSE {:.2} %, R² {:.4} as fitted{reference} (residual noise floor {} RMS)\n",
         d.base_model,

@@ -25,17 +25,15 @@ pub fn section(rep: &mut Report, dir: &Path, stem: &str, d: &Diagnosis, names: (
     let out_unit = unit_of(names.1).unwrap_or("");
     let unit = |n: &str| unit_of(n).map(|u| format!(" ({u})")).unwrap_or_default();
     let yl = format!("{}{}", names.1, unit(names.1));
-    let (b, r) = (&d.base_heldout, &d.reference_heldout);
+    let b = &d.base_heldout;
     // The fit alone and the reference the candidates were judged against, when they differ.
-    let reference = if format!("{:.2}", 100.0 * r.r_rmse) != format!("{:.2}", 100.0 * b.r_rmse) {
+    let reference = d.reference_apart().map_or_else(String::new, |r| {
         format!(
             "; refitted until it stalls, the reference every candidate is judged against: R-RMSE {:.2} %, R² {:.4}",
             100.0 * r.r_rmse,
             r.r2
         )
-    } else {
-        String::new()
-    };
+    });
     rep.paragraph(&format!(
         "Base model **{}** (fitted on the first {:.0} % with the channels as recorded), held-out R-RMSE {:.2} %, \
          R² {:.4}{reference}; with every finding's term: R-RMSE {:.2} %, R² {:.4}. Residual noise floor {} (RMS); \

@@ -127,6 +127,15 @@ pub struct Diagnosis {
     pub plot: PlotData,
 }
 
+impl Diagnosis {
+    /// The reference's held-out metrics when they read otherwise than the fit's at two
+    /// decimals of a per cent; `None` when the header needs one figure only.
+    pub fn reference_apart(&self) -> Option<&Metrics> {
+        let pct = |m: &Metrics| format!("{:.2}", 100.0 * m.r_rmse);
+        (pct(&self.reference_heldout) != pct(&self.base_heldout)).then_some(&self.reference_heldout)
+    }
+}
+
 /// What the report draws.
 #[derive(Clone, Debug, Default)]
 pub struct PlotData {
