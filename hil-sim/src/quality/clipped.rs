@@ -1,6 +1,6 @@
 //! Clipping: a channel flat or pinned at its extreme (sensor/ADC range, end stop), found
 //! as episodes of visits to a band at the maximum or minimum that dwell long enough or
-//! stay flat long enough, and whose visits are flat rather than a peak's curve.
+//! stay flat long enough, and whose longest hump is level rather than a free peak's curve.
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -40,8 +40,8 @@ pub(super) fn clipping(ctx: &Ctx, name: &str, v: &[f64], s: &Scale, cfg: &Qualit
             let long = dwell >= cfg.clip_dwell * s.half_period || longest_flat >= flat_needed;
             // How deep into the band the hump's parabola reaches, and how far it falls from there.
             let (top, fall) = parabola(ctx.t, v, longest_hump(v, &e, ext, 2.0 * band), sign);
-            let flat = fall <= cfg.clip_curved * (top - (sign * ext - band));
-            if long && flat {
+            let level_top = fall <= cfg.clip_curved * (top - (sign * ext - band));
+            if long && level_top {
                 let what = format!(
                     "{name} clipped at {}{} (its {side}) {}, within {:.0} % of the span of it for {:.2} s",
                     level(ext),
