@@ -2,12 +2,11 @@
 //! as episodes of visits to a band at the maximum or minimum that dwell long enough or
 //! stay flat long enough, and whose longest hump is level rather than a free peak's curve.
 
-use nalgebra::{Matrix3, Vector3};
-
 use super::config::QualityConfig;
 use super::runs;
 use super::scale::Scale;
 use super::warning::{level, Ctx, Warning, WarningKind};
+use crate::numerics::lstsq;
 use crate::numerics::units::unit_suffix;
 
 pub(super) fn clipping(ctx: &Ctx, name: &str, v: &[f64], s: &Scale, cfg: &QualityConfig) -> Vec<Warning> {
@@ -94,14 +93,9 @@ fn parabola(t: &[f64], v: &[f64], visits: &[(usize, usize)], sign: f64) -> (f64,
     if ts.len() < 3 || half <= 0.0 {
         return flat;
     }
-    let (mut ata, mut aty) = (Matrix3::<f64>::zeros(), Vector3::<f64>::zeros());
-    for (&ti, &vi) in ts.iter().zip(vs) {
-        let u = (ti - mid) / half;
-        let row = Vector3::new(1.0, u, u * u);
-        ata += row * row.transpose();
-        aty += row * (sign * vi);
-    }
-    let Some(c) = ata.lu().solve(&aty) else { return flat };
+    let rows: Vec<[f64; 3]> = ts.iter().map(|&ti| (ti - mid) / half).map(|u| [1.0, u, u * u]).collect();
+    let y: Vec<f64> = vs.iter().map(|v| sign * v).collect();
+    let Some(c) = lstsq::fit_rows(&rows, &y) else { return flat };
     let p = |u: f64| c[0] + c[1] * u + c[2] * u * u;
     let vertex = if c[2] < 0.0 { -c[1] / (2.0 * c[2]) } else { f64::NAN };
     let top = if vertex.abs() <= 1.0 { p(vertex) } else { p(-1.0).max(p(1.0)) };
