@@ -14,6 +14,7 @@ use super::augment::{Fitted, Problem};
 use super::candidates::Candidate;
 use super::diagnosis::Tested;
 use super::lag_or_delay::{self, Mixture, Side};
+use super::physical::Reading;
 use super::rank::Scored;
 use super::replicate::{self, Replication, Reversed};
 use super::significance::{self, Test};
@@ -33,6 +34,8 @@ pub struct Judge<'a> {
 /// The candidate kept in a round.
 pub struct Accepted {
     pub scored: Scored,
+    /// What it stands for ([`super::physical::reading`]).
+    pub reading: Reading,
     pub test: Test,
     pub after: Metrics,
     /// The reversed split, when the tail alone did not settle it.
@@ -60,7 +63,8 @@ impl Judge<'_> {
 
     /// Judge the `ranked` candidates of round `round` (1-based) of `prob` against `reference`: of the
     /// eligible ones (a training gain, significant on the held-out blocks, resolvable above
-    /// the noise, physically possible), the one with the lowest held-out error is kept — the
+    /// the noise, physically possible, not read as an effect `named` in an earlier round), the
+    /// one with the lowest held-out error is kept — the
     /// term that predicts data it was not fitted on best, not the one that fits the
     /// training part best (a wrong term on a misfitting base can fit more and predict less).
     /// The candidates that would predict better still but miss only the block test get the
@@ -74,6 +78,7 @@ impl Judge<'_> {
         cands: &[Candidate],
         reference: &Fitted,
         ranked: Vec<Scored>,
+        named: &[&str],
     ) -> Verdict {
         let before = self.heldout(&reference.pred);
         let mut tested = Vec::with_capacity(ranked.len());
@@ -86,17 +91,19 @@ impl Judge<'_> {
             // What the term changes in the prediction must be resolvable above the noise.
             let change_of_noise = acting::rms_change(&f.pred, &reference.pred, self.rows) / self.noise_rms.max(1e-300);
             let resolvable = change_of_noise >= significance::MIN_TERM_OF_NOISE;
-            let impossible =
-                super::physical::impossible(c, f, reference.terms.len(), s.value, self.dt, &prob.data.input);
+            let (n_old, x) = (reference.terms.len(), &prob.data.input);
+            let impossible = super::physical::impossible(c, f, n_old, s.value, self.dt, x);
+            let reading = super::physical::reading(c, f, n_old, x);
             let fits = impossible.is_none() && s.bic_gain > 0.0 && f.train_mse < reference.train_mse && resolvable;
             let tail_share = acting::tail_share(&f.pred, &reference.pred, self.held, &prob.train);
             let otherwise = fits
+                && !named.contains(&reading.effect)
                 && test.gain >= significance::MIN_FINDING_GAIN
                 && before.r_rmse - after.r_rmse >= significance::MIN_FINDING_DROP;
             tested.push(Tested {
                 round,
-                effect: c.effect.to_owned(),
-                label: c.label.clone(),
+                effect: reading.effect.to_owned(),
+                label: reading.label.clone(),
                 value: c.grid_name.clone().map(|n| (n, s.value)),
                 bic_gain: s.bic_gain,
                 heldout_r_rmse_before: before.r_rmse,
@@ -111,7 +118,8 @@ impl Judge<'_> {
                 acting: None,
             });
             let quiet = fits && tail_share < acting::QUIET_TAIL;
-            judged.push(Judged { otherwise, significant: test.significant, quiet, tail_share, scored: s, test, after });
+            let significant = test.significant;
+            judged.push(Judged { otherwise, significant, quiet, tail_share, scored: s, test, after, reading });
         }
         let reversed = Reversed::new(prob, reference);
         let replicate = |k: usize| {
@@ -119,7 +127,7 @@ impl Judge<'_> {
             let tail = significance::blocks(self.y, &reference.pred, &s.fitted.pred, self.held);
             reversed.replicate(&cands[s.index], s, &tail)
         };
-        let effect = |k: usize| cands[judged[k].scored.index].effect;
+        let effect = |k: usize| judged[k].reading.effect;
         let mixture = |lag: usize, delay: usize| {
             let (l, d) = (&judged[lag].scored, &judged[delay].scored);
             lag_or_delay::profile(prob, reference, (&cands[l.index], l), (&cands[d.index], d))
@@ -134,15 +142,15 @@ impl Judge<'_> {
         let accepted = best.map(|k| {
             tested[k].kept = true;
             let (replication, lag_or_delay, acting) = (tested[k].replication, tested[k].lag_or_delay, tested[k].acting);
-            let Judged { scored, test, after, .. } = judged.swap_remove(k);
-            Accepted { scored, test, after, replication, lag_or_delay, acting }
+            let Judged { scored, test, after, reading, .. } = judged.swap_remove(k);
+            Accepted { scored, reading, test, after, replication, lag_or_delay, acting }
         });
         Verdict { before, tested, accepted }
     }
 }
 
 /// A candidate as judged: every condition but the block test met (`otherwise`), the block
-/// test passed, its score, test and held-out metrics.
+/// test passed, its score, test, held-out metrics and what it stands for.
 struct Judged {
     otherwise: bool,
     significant: bool,
@@ -152,6 +160,7 @@ struct Judged {
     scored: Scored,
     test: Test,
     after: Metrics,
+    reading: Reading,
 }
 
 /// How [`choose`] breaks what the tail leaves open, per judged candidate: its reversed split,

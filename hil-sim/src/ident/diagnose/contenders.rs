@@ -104,7 +104,7 @@ pub fn open<'a>(base: &'a Base, s: &Shared<'a, '_>, with_plays: bool) -> Result<
     }
     let reference = rank::reference(&prob, &current).ok_or_else(diverges)?;
     let first = rank::rank(&prob, s.cands, &reference, &[]).map(|(reference, ranked)| {
-        let verdict = judge.round(1, &prob, s.cands, &reference, ranked);
+        let verdict = judge.round(1, &prob, s.cands, &reference, ranked, &[]);
         (reference, verdict)
     });
     Ok(Opening { base, plays: with_plays, before, prob, current, level, located, first })
@@ -171,14 +171,8 @@ pub fn choose(openings: &[Opening<'_>], judge: &Judge<'_>) -> usize {
 /// The notes a diagnosis carries about its base, the opening `chosen` (`names`: the input's
 /// and the output's): why it is not the best-fitting base, its play operators, its level
 /// term.
-pub fn notes(
-    openings: &[Opening<'_>],
-    chosen: usize,
-    judge: &Judge<'_>,
-    cands: &[Candidate],
-    names: (&str, &str),
-) -> Vec<String> {
-    let mut out: Vec<String> = note(openings, chosen, judge, cands).into_iter().collect();
+pub fn notes(openings: &[Opening<'_>], chosen: usize, judge: &Judge<'_>, names: (&str, &str)) -> Vec<String> {
+    let mut out: Vec<String> = note(openings, chosen, judge).into_iter().collect();
     if let Some(o) = openings.get(chosen) {
         let id = &o.base.fit.model;
         out.extend(o.plays.then(|| play_note(id, names.0)));
@@ -200,7 +194,7 @@ fn play_note(id: &str, input: &str) -> String {
 
 /// The note a diagnosis carries when the opening `chosen` is not the best-fitting base's
 /// (`openings[0]`); `None` when it is.
-fn note(openings: &[Opening<'_>], chosen: usize, judge: &Judge<'_>, cands: &[Candidate]) -> Option<String> {
+fn note(openings: &[Opening<'_>], chosen: usize, judge: &Judge<'_>) -> Option<String> {
     let (best, picked) = (openings.first()?, openings.get(chosen)?);
     if chosen == 0 {
         return None;
@@ -224,8 +218,8 @@ fn note(openings: &[Opening<'_>], chosen: usize, judge: &Judge<'_>, cands: &[Can
              block test ({} → {})",
             pct(&alone(picked)),
             pct(&alone(best)),
-            cands[a.scored.index].effect,
-            cands[a.scored.index].label,
+            a.reading.effect,
+            a.reading.label,
             pct(&alone(picked)),
             pct(&a.after),
         ),

@@ -12,6 +12,7 @@ use super::candidates::{Candidate, DIRECTION_SQUARED_TERM, DIRECTION_TERM, LOADI
 use super::diagnosis::{Evidence, Finding, Tested};
 use super::lag_or_delay::Mixture;
 use super::locate::{self, Condition};
+use super::physical::Reading;
 use super::replicate::Replication;
 use super::significance::Test;
 use crate::ident::fit::Dataset;
@@ -21,6 +22,8 @@ use crate::numerics::metrics::Metrics;
 pub struct Described<'a> {
     pub data: &'a Dataset,
     pub candidate: &'a Candidate,
+    /// What the candidate stands for as fitted ([`super::physical::reading`]).
+    pub reading: &'a Reading,
     /// The model with the candidate's term, and the round's reference without it.
     pub fitted: &'a Fitted,
     pub reference: &'a Fitted,
@@ -148,7 +151,7 @@ pub fn finding(d: &Described<'_>) -> Finding {
             )
         })
         .unwrap_or_default();
-    let both = d.lag_or_delay.map(|m| mixture_clause(&m, c.effect)).unwrap_or_default();
+    let both = d.lag_or_delay.map(|m| mixture_clause(&m, d.reading.effect)).unwrap_or_default();
     let acts = d.acting.map(|a| acting_clause(&a)).unwrap_or_default();
     let summary = format!(
         "{}; {size}; held-out R-RMSE {:.2} % -> {:.2} % ({}){again}{both}{acts}{weak}{}",
@@ -164,7 +167,7 @@ pub fn finding(d: &Described<'_>) -> Finding {
         caveats(data, &windows, d.boundaries)
     );
     Finding {
-        effect: c.effect.to_owned(),
+        effect: d.reading.effect.to_owned(),
         summary,
         windows,
         params,
@@ -173,7 +176,7 @@ pub fn finding(d: &Described<'_>) -> Finding {
         heldout_after: d.after,
         conditions,
         evidence: Evidence {
-            label: c.label.clone(),
+            label: d.reading.label.clone(),
             channel: c.channel.clone(),
             test: d.test,
             replication: d.replication,
@@ -223,7 +226,22 @@ fn what(d: &Described<'_>) -> String {
     let coef = f.beta.get(d.reference.terms.len()).copied().unwrap_or(0.0);
     let coef2 = f.beta.get(d.reference.terms.len() + 1).copied().unwrap_or(0.0);
     let ch = c.channel.clone().unwrap_or_default();
-    match c.effect {
+    match d.reading.effect {
+        "saturation" if d.reading.narrowing => {
+            let term = f.terms.get(d.reference.terms.len()).map_or("", |t| t.name.as_str());
+            let how = match term {
+                LOADING_TERM => format!("the loading branch falls by {} per {xu} above its floor", with_unit(-coef, &yu)),
+                DIRECTION_SQUARED_TERM => format!(
+                    "the loading/unloading difference falls by {} per ({xu})² away from its mean, towards both ends",
+                    with_unit(-coef, &yu)
+                ),
+                _ => format!("the loading/unloading difference falls by {} per {xu}", with_unit(-coef, &yu)),
+            };
+            format!(
+                "the loop between loading and unloading narrows as the {i} grows ({how}): the fluid's yield stress \
+                 levelling off at high field"
+            )
+        }
         "field_lag" if c.label.contains("two-pole") => format!(
             "the {o} lags the {i} reading through two first-order lags of {:.2} ms each ({:.2} ms in all: a field diffusing through the discs, or eddy currents behind a coil lag)",
             0.5e3 * g,

@@ -145,7 +145,7 @@ fn diagnose_at_rate(
     let mut openings = contenders::open_all(&fitted, &shared)?;
     let chosen = contenders::choose(&openings, &judge0);
     let mut notes: Vec<String> = fitted.failed.iter().cloned().chain(rate_note).collect();
-    notes.extend(contenders::notes(&openings, chosen, &judge0, &cands, names));
+    notes.extend(contenders::notes(&openings, chosen, &judge0, names));
     let contenders::Opening { base, before, prob, mut current, located, first, .. } = openings.swap_remove(chosen);
     let id = base.fit.model.clone();
     let judge = Judge { noise_rms: located.noise_rms, ..judge0 };
@@ -165,8 +165,9 @@ fn diagnose_at_rate(
             Some(f) => f,
             None => {
                 let reference = rank::reference(&prob, &current).ok_or_else(diverges)?;
+                let named: Vec<&str> = findings.iter().map(|f: &diagnosis::Finding| f.effect.as_str()).collect();
                 rank::rank(&prob, &cands, &reference, &used).map(|(reference, ranked)| {
-                    let verdict = judge.round(round + 1, &prob, &cands, &reference, ranked);
+                    let verdict = judge.round(round + 1, &prob, &cands, &reference, ranked, &named);
                     (reference, verdict)
                 })
             }
@@ -179,10 +180,12 @@ fn diagnose_at_rate(
         tested.extend(verdict.tested);
         let Some(kept) = verdict.accepted else { break };
         let c = &cands[kept.scored.index];
-        let runner_up = describe::runner_up(&tested, round + 1, c.effect, &kept.test, kept.after.r_rmse);
+        let effect = kept.reading.effect;
+        let runner_up = describe::runner_up(&tested, round + 1, effect, &kept.test, kept.after.r_rmse);
         findings.push(describe::finding(&Described {
             data,
             candidate: c,
+            reading: &kept.reading,
             fitted: &kept.scored.fitted,
             reference: &reference,
             value: kept.scored.value,
@@ -202,7 +205,10 @@ fn diagnose_at_rate(
             runner_up,
         }));
         // Neither it nor a candidate of the same effect on the same channel is tested again.
-        used.extend((0..cands.len()).filter(|&j| cands[j].effect == c.effect && cands[j].channel == c.channel));
+        let k = kept.scored.index;
+        used.extend(
+            (0..cands.len()).filter(|&j| j == k || (cands[j].effect == effect && cands[j].channel == c.channel)),
+        );
         current = kept.scored.fitted;
     }
     let final_heldout = if findings.is_empty() { reference_heldout } else { judge.heldout(&current.pred) };

@@ -1,10 +1,14 @@
 //! Whether a candidate's fitted values are physically possible: a finding is never a
 //! negative mass or inertia, a time constant or saturation level that is not positive, a
 //! yield-stress saturation that expands the torque instead or turns it down at the top,
-//! a loop that narrows as the input grows (the catalog's asymmetry is a loop *widening* with
-//! the input; one narrowing at high level is the yield stress levelling off, a saturation),
-//! or a lag, delay or channel lag pinned at the edge of its search range (the refit
-//! wanted more than the range allows: the term is standing in for something else).
+//! a loop that narrows both ways from the input's mean, or a lag, delay or channel lag
+//! pinned at the edge of its search range (the refit wanted more than the range allows: the
+//! term is standing in for something else).
+//!
+//! And what a fitted candidate stands for ([`reading`]): the catalog's asymmetry is a loop
+//! *widening* with the input; a direction or loading-branch term that *narrows* the loop as a
+//! field of one polarity grows is the yield stress levelling off at high field, a
+//! `saturation`.
 
 use super::augment::Fitted;
 use super::candidates::{Candidate, DIRECTION_SQUARED_TERM, DIRECTION_TERM, LOADING_TERM};
@@ -13,14 +17,53 @@ use super::candidates::{Candidate, DIRECTION_SQUARED_TERM, DIRECTION_TERM, LOADI
 /// (crossing zero only by an offset or noise).
 pub const ONE_SIDED: f64 = 0.1;
 
+/// Whether the field `x` is two-sided: each polarity reaches beyond [`ONE_SIDED`] of the other's top.
+fn two_sided(x: &[f64]) -> bool {
+    let (lo, hi) = crate::numerics::stats::min_max(x);
+    lo < -ONE_SIDED * hi && hi > -ONE_SIDED * lo
+}
+
+/// What a fitted candidate stands for: its effect and its label in words.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reading {
+    pub effect: &'static str,
+    pub label: String,
+    /// A direction or loading-branch term read as the loop narrowing at high level.
+    pub narrowing: bool,
+}
+
+/// The candidate `c` as fitted (`f`, with `n_old` terms of the reference before its own) on
+/// the input `x`: a direction or loading-branch term whose loop narrows as a field of one
+/// polarity grows ([`narrowing_loop`]), or a squared direction term narrowing it towards both
+/// ends of a two-sided field, is a `saturation`, the loop's width (the yield stress) levelling
+/// off at high field; any other candidate is its own effect.
+pub fn reading(c: &Candidate, f: &Fitted, n_old: usize, x: &[f64]) -> Reading {
+    let coef = f.beta.get(n_old).copied().unwrap_or(0.0);
+    let term = f.terms.get(n_old).map(|t| t.name.as_str());
+    let narrows = c.effect == "asymmetry" && term.and_then(|t| narrowing_loop(t, coef, x)).is_some();
+    let how = match term {
+        Some(DIRECTION_TERM) if narrows => "loading/unloading difference shrinking at high input",
+        Some(LOADING_TERM) if narrows => "loading branch lowered at high input",
+        Some(DIRECTION_SQUARED_TERM) if narrows && two_sided(x) => {
+            "loading/unloading difference shrinking towards both ends of a two-sided input"
+        }
+        _ => return Reading { effect: c.effect, label: c.label.clone(), narrowing: false },
+    };
+    Reading { effect: "saturation", label: format!("loop narrowing as the input grows ({how})"), narrowing: true }
+}
+
 /// Why the fitted candidate is impossible (in words, with the value and its unit), or
 /// `None` when it is possible. `n_old` is the number of terms the reference already had;
 /// `dt` the sample interval (s): a delay shorter than one sample is no finding, since a base
 /// model stepped once per sample lags its own state by up to that much; `x` the input.
 pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64, x: &[f64]) -> Option<String> {
     let coef = f.beta.get(n_old).copied().unwrap_or(0.0);
-    if c.effect == "asymmetry" {
-        if let Some(why) = f.terms.get(n_old).and_then(|t| narrowing_loop(&t.name, coef, x)) {
+    // A direction or loading-branch term narrowing the loop is read as a saturation
+    // ([`reading`]), and so is the squared form on a two-sided field (narrowing towards both
+    // of its ends); on a field of one polarity that form narrows the loop at its low end too.
+    if c.effect == "asymmetry" && !two_sided(x) {
+        let squared = f.terms.get(n_old).filter(|t| t.name == DIRECTION_SQUARED_TERM);
+        if let Some(why) = squared.and_then(|t| narrowing_loop(&t.name, coef, x)) {
             return Some(why);
         }
     }
@@ -163,5 +206,58 @@ mod tests {
         assert!(narrowing_loop(DIRECTION_SQUARED_TERM, -0.3, &positive).is_some());
         assert_eq!(narrowing_loop(DIRECTION_SQUARED_TERM, 0.3, &positive), None);
         assert_eq!(narrowing_loop("c_rate", -0.3, &positive), None);
+    }
+
+    /// A direction (or loading-branch, or squared) candidate refitted with coefficient `k` on
+    /// the input `x`.
+    fn direction(term: &'static str, k: f64, x: &[f64]) -> (Candidate, Fitted) {
+        let v = x.to_vec();
+        let c = Candidate {
+            effect: "asymmetry",
+            label: "loading/unloading difference growing with the input".into(),
+            grid_name: None,
+            grid: vec![0.0],
+            build: Box::new(move |_| Piece { transform: None, terms: vec![Term::additive(term, v.clone())] }),
+            channel: None,
+        };
+        let f = Fitted {
+            transforms: vec![],
+            terms: vec![Term::additive(term, x.to_vec())],
+            theta: vec![],
+            beta: vec![k],
+            model: x.to_vec(),
+            pred: vec![],
+            train_mse: 0.0,
+        };
+        (c, f)
+    }
+
+    #[test]
+    fn a_loop_narrowing_as_a_one_sided_field_grows_is_read_as_a_saturation() {
+        let positive: Vec<f64> = (0..=100).map(|i| 0.05 + 0.005 * f64::from(i)).collect();
+        let two_sided: Vec<f64> = (0..=100).map(|i| -0.5 + 0.01 * f64::from(i)).collect();
+        let read = |term, k, x: &[f64]| {
+            let (c, f) = direction(term, k, x);
+            (reading(&c, &f, 0, x), impossible(&c, &f, 0, 0.0, 1e-3, x))
+        };
+        for term in [DIRECTION_TERM, LOADING_TERM] {
+            let (r, why) = read(term, -0.3, &positive);
+            assert_eq!((r.effect, r.narrowing, why), ("saturation", true, None), "{term}");
+            assert!(r.label.starts_with("loop narrowing as the input grows"), "{}", r.label);
+            let (r, why) = read(term, 0.3, &positive);
+            assert_eq!((r.effect, r.narrowing, why), ("asymmetry", false, None), "{term}");
+        }
+        // On a two-sided field either sign of the linear form is an asymmetry.
+        let (r, why) = read(DIRECTION_TERM, -0.3, &two_sided);
+        assert_eq!((r.effect, why), ("asymmetry", None));
+        // The squared form narrowing towards both ends is a saturation on a two-sided field;
+        // on a field of one polarity it narrows the low end too: impossible, and no saturation.
+        let (r, why) = read(DIRECTION_SQUARED_TERM, -0.3, &two_sided);
+        assert_eq!((r.effect, r.narrowing, why), ("saturation", true, None));
+        let (r, why) = read(DIRECTION_SQUARED_TERM, 0.3, &two_sided);
+        assert_eq!((r.effect, why), ("asymmetry", None));
+        let (r, why) = read(DIRECTION_SQUARED_TERM, -0.3, &positive);
+        assert_eq!(r.effect, "asymmetry");
+        assert!(why.is_some_and(|w| w.contains("narrowing")));
     }
 }

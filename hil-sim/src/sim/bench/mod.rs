@@ -166,6 +166,11 @@ pub enum Set {
     /// peaks' samples stay in the fit).
     Fresh40,
     Fresh41,
+    /// The forty-third and forty-fourth, first run for the thirteenth report of 2026-11-29 (a
+    /// direction term narrowing the loop as a one-sided field grows, or its squared form
+    /// narrowing it towards both ends of a two-sided field, is named a saturation).
+    Fresh42,
+    Fresh43,
 }
 
 impl Set {
@@ -214,6 +219,8 @@ impl Set {
         ("fresh39", Set::Fresh39),
         ("fresh40", Set::Fresh40),
         ("fresh41", Set::Fresh41),
+        ("fresh42", Set::Fresh42),
+        ("fresh43", Set::Fresh43),
     ];
 
     /// The seed of case `k` of this set.
@@ -262,6 +269,8 @@ impl Set {
             Set::Fresh39 => 416_000_000 + 191 * k,
             Set::Fresh40 => 436_000_000 + 193 * k,
             Set::Fresh41 => 458_000_000 + 197 * k,
+            Set::Fresh42 => 480_000_000 + 199 * k,
+            Set::Fresh43 => 502_000_000 + 211 * k,
         }
     }
 }
