@@ -218,6 +218,26 @@ fn mixture_clause(m: &Mixture, effect: &str) -> String {
     )
 }
 
+/// A direction term read as the loop narrowing at high level ([`super::physical::reading`]),
+/// in words: `coef` its coefficient, the input's name and the input's and output's units.
+fn narrowing(d: &Described<'_>, coef: f64, (i, xu, yu): (&str, &str, &str)) -> String {
+    let term = d.fitted.terms.get(d.reference.terms.len()).map_or("", |t| t.name.as_str());
+    let fall = with_unit(-coef, yu);
+    let how = match term {
+        LOADING_TERM => format!("the loading branch falls by {fall} per {xu} above its floor"),
+        DIRECTION_SQUARED_TERM => {
+            format!(
+                "the loading/unloading difference falls by {fall} per ({xu})² away from its mean, towards both ends"
+            )
+        }
+        _ => format!("the loading/unloading difference falls by {fall} per {xu}"),
+    };
+    format!(
+        "the loop between loading and unloading narrows as the {i} grows ({how}): the fluid's yield stress levelling \
+         off at high field"
+    )
+}
+
 /// Which physics, in words.
 fn what(d: &Described<'_>) -> String {
     let (c, f, g, dt) = (d.candidate, d.fitted, d.value, d.data.dt);
@@ -227,21 +247,7 @@ fn what(d: &Described<'_>) -> String {
     let coef2 = f.beta.get(d.reference.terms.len() + 1).copied().unwrap_or(0.0);
     let ch = c.channel.clone().unwrap_or_default();
     match d.reading.effect {
-        "saturation" if d.reading.narrowing => {
-            let term = f.terms.get(d.reference.terms.len()).map_or("", |t| t.name.as_str());
-            let how = match term {
-                LOADING_TERM => format!("the loading branch falls by {} per {xu} above its floor", with_unit(-coef, &yu)),
-                DIRECTION_SQUARED_TERM => format!(
-                    "the loading/unloading difference falls by {} per ({xu})² away from its mean, towards both ends",
-                    with_unit(-coef, &yu)
-                ),
-                _ => format!("the loading/unloading difference falls by {} per {xu}", with_unit(-coef, &yu)),
-            };
-            format!(
-                "the loop between loading and unloading narrows as the {i} grows ({how}): the fluid's yield stress \
-                 levelling off at high field"
-            )
-        }
+        "saturation" if d.reading.narrowing => narrowing(d, coef, (i, &xu, &yu)),
         "field_lag" if c.label.contains("two-pole") => format!(
             "the {o} lags the {i} reading through two first-order lags of {:.2} ms each ({:.2} ms in all: a field diffusing through the discs, or eddy currents behind a coil lag)",
             0.5e3 * g,

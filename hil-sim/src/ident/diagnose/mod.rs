@@ -153,7 +153,7 @@ fn diagnose_at_rate(
     let reference_heldout = first.as_ref().map_or_else(|| judge.heldout(&current.pred), |(_, v)| v.before);
     // 3–4. Name and model, round by round.
     let diverges = || DiagnoseError::Diverges(id.clone());
-    let (mut findings, mut tested, mut used) = (Vec::new(), Vec::new(), Vec::<usize>::new());
+    let (mut findings, mut tested, mut used, mut named) = (Vec::new(), Vec::new(), Vec::<usize>::new(), Vec::new());
     let y_span = span_on(&data.output, &held);
     // Joins of a dataset's runs, with any the caller gave: a finding sitting on one says so.
     let boundaries: Vec<usize> =
@@ -165,7 +165,6 @@ fn diagnose_at_rate(
             Some(f) => f,
             None => {
                 let reference = rank::reference(&prob, &current).ok_or_else(diverges)?;
-                let named: Vec<&str> = findings.iter().map(|f: &diagnosis::Finding| f.effect.as_str()).collect();
                 rank::rank(&prob, &cands, &reference, &used).map(|(reference, ranked)| {
                     let verdict = judge.round(round + 1, &prob, &cands, &reference, ranked, &named);
                     (reference, verdict)
@@ -179,12 +178,11 @@ fn diagnose_at_rate(
         progress.advance(2);
         tested.extend(verdict.tested);
         let Some(kept) = verdict.accepted else { break };
-        let c = &cands[kept.scored.index];
         let effect = kept.reading.effect;
         let runner_up = describe::runner_up(&tested, round + 1, effect, &kept.test, kept.after.r_rmse);
         findings.push(describe::finding(&Described {
             data,
-            candidate: c,
+            candidate: &cands[kept.scored.index],
             reading: &kept.reading,
             fitted: &kept.scored.fitted,
             reference: &reference,
@@ -204,11 +202,8 @@ fn diagnose_at_rate(
             boundaries: &boundaries,
             runner_up,
         }));
-        // Neither it nor a candidate of the same effect on the same channel is tested again.
-        let k = kept.scored.index;
-        used.extend(
-            (0..cands.len()).filter(|&j| j == k || (cands[j].effect == effect && cands[j].channel == c.channel)),
-        );
+        used.extend(spent(&cands, kept.scored.index, effect));
+        named.push(effect);
         current = kept.scored.fitted;
     }
     let final_heldout = if findings.is_empty() { reference_heldout } else { judge.heldout(&current.pred) };
@@ -266,6 +261,13 @@ fn with_zero_phase_rate(data: &Dataset, opts: &DiagnoseOptions, input: &str) -> 
         )
     });
     (data, cutoff, note)
+}
+
+/// The kept candidate `k` (read as `effect`) and every candidate of that effect on its
+/// channel: none of them is tested again.
+fn spent<'a>(cands: &'a [candidates::Candidate], k: usize, effect: &'a str) -> impl Iterator<Item = usize> + 'a {
+    let channel = cands.get(k).and_then(|c| c.channel.as_deref());
+    (0..cands.len()).filter(move |&j| j == k || (cands[j].effect == effect && cands[j].channel.as_deref() == channel))
 }
 
 /// The note of a round (1-based) whose base `id` could not be differentiated.
