@@ -1,14 +1,14 @@
 //! Whether a candidate's fitted values are physically possible: a finding is never a
 //! negative mass or inertia, a time constant or saturation level that is not positive, a
 //! yield-stress saturation that expands the torque instead or turns it down at the top,
-//! a loop that narrows both ways from the input's mean, or a lag, delay or channel lag
-//! pinned at the edge of its search range (the refit wanted more than the range allows: the
-//! term is standing in for something else).
+//! a loop that narrows both ways from the mean of a field of one polarity (at its low end
+//! too), or a lag, delay or channel lag pinned at the edge of its search range (the refit
+//! wanted more than the range allows: the term is standing in for something else).
 //!
 //! And what a fitted candidate stands for ([`reading`]): the catalog's asymmetry is a loop
 //! *widening* with the input; a direction or loading-branch term that *narrows* the loop as a
-//! field of one polarity grows is the yield stress levelling off at high field, a
-//! `saturation`.
+//! field of one polarity grows, or the squared form narrowing it towards both ends of a
+//! two-sided field, is the yield stress levelling off at high field, a `saturation`.
 
 use super::augment::Fitted;
 use super::candidates::{Candidate, DIRECTION_SQUARED_TERM, DIRECTION_TERM, LOADING_TERM};
@@ -28,7 +28,7 @@ fn two_sided(x: &[f64]) -> bool {
 pub struct Reading {
     pub effect: &'static str,
     pub label: String,
-    /// A direction or loading-branch term read as the loop narrowing at high level.
+    /// A direction term (linear, loading-branch or squared) read as the loop narrowing at high level.
     pub narrowing: bool,
 }
 
@@ -123,8 +123,9 @@ pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64, 
 /// widen it. On a negative or two-sided field the two readings part (the catalog's signed
 /// `δ·x` with δ > 0 narrows the loop towards a large negative field), so either sign is
 /// possible there. The loading branch lifted, `δ_l·(x − x_min)·(1 + sgn(ẋ))/2`, widens the
-/// loop by `δ_l·(x − x_min)` and is judged alike. `δ₂·(x − x̄)²·sgn(ẋ)` must widen away
-/// from x̄ (a saturation narrows both ends).
+/// loop by `δ_l·(x − x_min)` and is judged alike. `δ₂·(x − x̄)²·sgn(ẋ)` with δ₂ < 0 narrows
+/// it both ways from x̄: on a two-sided field that is a saturation at both polarities
+/// ([`reading`]); on a field of one polarity it narrows the low end too.
 fn narrowing_loop(term: &str, coef: f64, x: &[f64]) -> Option<String> {
     let (lo, hi) = crate::numerics::stats::min_max(x);
     let positive = hi > 0.0 && lo >= -ONE_SIDED * hi;
@@ -133,11 +134,15 @@ fn narrowing_loop(term: &str, coef: f64, x: &[f64]) -> Option<String> {
         DIRECTION_SQUARED_TERM => coef < 0.0,
         _ => false,
     };
-    narrows.then(|| {
-        format!(
-            "a loop narrowing as the input grows ({term} = {}): the output levelling off at high level, a saturation's sign",
-            crate::numerics::number::num(coef, 4)
-        )
+    let coef = crate::numerics::number::num(coef, 4);
+    narrows.then(|| match term {
+        DIRECTION_SQUARED_TERM => format!(
+            "a loop narrowing both ways from the input's mean ({term} = {coef}): on a field of one polarity at its low \
+             end too, neither a widening asymmetry nor a saturation"
+        ),
+        _ => format!(
+            "a loop narrowing as the input grows ({term} = {coef}): the output levelling off at high level, a saturation's sign"
+        ),
     })
 }
 
