@@ -191,7 +191,8 @@ fn candidates_table(rep: &mut Report, d: &Diagnosis) {
         .collect();
     rep.paragraph(&format!(
         "Every candidate tested, by round, by BIC gain (kept: of those that pass the held-out block test, the one with \
-         the lowest held-out error; not possible: fitted values no physical cause has, never kept). Reversed split: a \
+         the lowest held-out error; not possible: fitted values no physical cause has, never kept; a direction term \
+         narrowing the loop as the input grows is read as a saturation). Reversed split: a \
          candidate the held-out tail left undecided, or close to another effect's, refitted with the first part of the \
          recording held out instead; its gain there and the signed-rank p \
          over the blocks of both held-out parts. When a round keeps nothing, a candidate the tail barely excites (it \
@@ -221,6 +222,7 @@ fn outcome(c: &Tested) -> String {
     match (&c.impossible, c.kept) {
         (_, true) => "kept".into(),
         (Some(why), false) => format!("not possible: {why}"),
+        (None, false) if c.named_before => format!("not kept: read as {}, named in an earlier round", c.effect),
         (None, false) => String::new(),
     }
 }
@@ -342,6 +344,7 @@ mod tests {
             tail_share: 1.0,
             kept: false,
             impossible: Some("a loop narrowing as the input grows (delta = -1.2)".into()),
+            named_before: false,
             replication: None,
             lag_or_delay: None,
             acting: None,
@@ -349,6 +352,10 @@ mod tests {
         assert_eq!(outcome(&c), "not possible: a loop narrowing as the input grows (delta = -1.2)");
         c.impossible = None;
         assert_eq!(outcome(&c), "");
+        c.named_before = true;
+        c.effect = "saturation".into();
+        assert_eq!(outcome(&c), "not kept: read as saturation, named in an earlier round");
+        c.named_before = false;
         c.kept = true;
         assert_eq!(outcome(&c), "kept");
     }

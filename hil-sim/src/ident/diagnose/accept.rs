@@ -96,8 +96,9 @@ impl Judge<'_> {
             let reading = super::physical::reading(c, f, n_old, x);
             let fits = impossible.is_none() && s.bic_gain > 0.0 && f.train_mse < reference.train_mse && resolvable;
             let tail_share = acting::tail_share(&f.pred, &reference.pred, self.held, &prob.train);
+            let named_before = named.contains(&reading.effect);
             let otherwise = fits
-                && !named.contains(&reading.effect)
+                && !named_before
                 && test.gain >= significance::MIN_FINDING_GAIN
                 && before.r_rmse - after.r_rmse >= significance::MIN_FINDING_DROP;
             tested.push(Tested {
@@ -113,6 +114,7 @@ impl Judge<'_> {
                 tail_share,
                 kept: false,
                 impossible,
+                named_before,
                 replication: None,
                 lag_or_delay: None,
                 acting: None,

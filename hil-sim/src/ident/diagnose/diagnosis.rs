@@ -85,6 +85,10 @@ pub struct Tested {
     /// Why its fitted values are physically impossible (then it is never kept).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub impossible: Option<String>,
+    /// Read as an effect an earlier round named ([`super::physical::reading`]: a loop
+    /// narrowing after a saturation): then it is never kept.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub named_before: bool,
     /// The reversed split, when it was given one ([`super::replicate`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub replication: Option<Replication>,
