@@ -12,7 +12,7 @@
 use super::acting::{self, Acting};
 use super::augment::{Fitted, Problem};
 use super::candidates::Candidate;
-use super::diagnosis::Tested;
+use super::diagnosis::{Finding, Tested};
 use super::lag_or_delay::{self, Mixture, Side};
 use super::physical::Reading;
 use super::rank::Scored;
@@ -63,7 +63,7 @@ impl Judge<'_> {
 
     /// Judge the `ranked` candidates of round `round` (1-based) of `prob` against `reference`: of the
     /// eligible ones (a training gain, significant on the held-out blocks, resolvable above
-    /// the noise, physically possible, not read as an effect `named` in an earlier round), the
+    /// the noise, physically possible, not read as the effect of a finding `named` in an earlier round), the
     /// one with the lowest held-out error is kept — the
     /// term that predicts data it was not fitted on best, not the one that fits the
     /// training part best (a wrong term on a misfitting base can fit more and predict less).
@@ -78,7 +78,7 @@ impl Judge<'_> {
         cands: &[Candidate],
         reference: &Fitted,
         ranked: Vec<Scored>,
-        named: &[&str],
+        named: &[Finding],
     ) -> Verdict {
         let before = self.heldout(&reference.pred);
         let mut tested = Vec::with_capacity(ranked.len());
@@ -96,7 +96,7 @@ impl Judge<'_> {
             let reading = super::physical::reading(c, f, n_old, x);
             let fits = impossible.is_none() && s.bic_gain > 0.0 && f.train_mse < reference.train_mse && resolvable;
             let tail_share = acting::tail_share(&f.pred, &reference.pred, self.held, &prob.train);
-            let named_before = named.contains(&reading.effect);
+            let named_before = named.iter().any(|n| n.effect == reading.effect);
             let otherwise = fits
                 && !named_before
                 && test.gain >= significance::MIN_FINDING_GAIN

@@ -153,7 +153,7 @@ fn diagnose_at_rate(
     let reference_heldout = first.as_ref().map_or_else(|| judge.heldout(&current.pred), |(_, v)| v.before);
     // 3–4. Name and model, round by round.
     let diverges = || DiagnoseError::Diverges(id.clone());
-    let (mut findings, mut tested, mut used, mut named) = (Vec::new(), Vec::new(), Vec::<usize>::new(), Vec::new());
+    let (mut findings, mut tested, mut used) = (Vec::new(), Vec::new(), Vec::<usize>::new());
     let y_span = span_on(&data.output, &held);
     // Joins of a dataset's runs, with any the caller gave: a finding sitting on one says so.
     let boundaries: Vec<usize> =
@@ -166,7 +166,7 @@ fn diagnose_at_rate(
             None => {
                 let reference = rank::reference(&prob, &current).ok_or_else(diverges)?;
                 rank::rank(&prob, &cands, &reference, &used).map(|(reference, ranked)| {
-                    let verdict = judge.round(round + 1, &prob, &cands, &reference, ranked, &named);
+                    let verdict = judge.round(round + 1, &prob, &cands, &reference, ranked, &findings);
                     (reference, verdict)
                 })
             }
@@ -203,7 +203,6 @@ fn diagnose_at_rate(
             runner_up,
         }));
         used.extend(spent(&cands, kept.scored.index, effect));
-        named.push(effect);
         current = kept.scored.fitted;
     }
     let final_heldout = if findings.is_empty() { reference_heldout } else { judge.heldout(&current.pred) };

@@ -38,18 +38,41 @@ pub struct Reading {
 /// ends of a two-sided field, is a `saturation`, the loop's width (the yield stress) levelling
 /// off at high field; any other candidate is its own effect.
 pub fn reading(c: &Candidate, f: &Fitted, n_old: usize, x: &[f64]) -> Reading {
-    let coef = f.beta.get(n_old).copied().unwrap_or(0.0);
-    let term = f.terms.get(n_old).map(|t| t.name.as_str());
-    let narrows = c.effect == "asymmetry" && term.and_then(|t| narrowing_loop(t, coef, x)).is_some();
-    let how = match term {
-        Some(DIRECTION_TERM) if narrows => "loading/unloading difference shrinking at high input",
-        Some(LOADING_TERM) if narrows => "loading branch lowered at high input",
-        Some(DIRECTION_SQUARED_TERM) if narrows && two_sided(x) => {
-            "loading/unloading difference shrinking towards both ends of a two-sided input"
+    match narrowing(c, f, n_old, x) {
+        Some(Narrowing::Saturation(how)) => Reading {
+            effect: "saturation",
+            label: format!("loop narrowing as the input grows ({how})"),
+            narrowing: true,
+        },
+        _ => Reading { effect: c.effect, label: c.label.clone(), narrowing: false },
+    }
+}
+
+/// A direction term that narrows the loop as the input grows, judged: a saturation (how, in
+/// words), or impossible (why).
+enum Narrowing {
+    Saturation(&'static str),
+    Impossible(String),
+}
+
+/// The one place that tells a narrowing loop's two readings apart ([`reading`] and
+/// [`impossible`] both ask it): the linear and loading-branch forms narrowing on a field of
+/// one polarity, and the squared form on a two-sided field, are saturations; the squared form
+/// on a field of one polarity is impossible; `None` when the candidate does not narrow the loop.
+fn narrowing(c: &Candidate, f: &Fitted, n_old: usize, x: &[f64]) -> Option<Narrowing> {
+    if c.effect != "asymmetry" {
+        return None;
+    }
+    let term = f.terms.get(n_old)?.name.as_str();
+    let why = narrowing_loop(term, f.beta.get(n_old).copied().unwrap_or(0.0), x)?;
+    Some(match term {
+        DIRECTION_TERM => Narrowing::Saturation("loading/unloading difference shrinking at high input"),
+        LOADING_TERM => Narrowing::Saturation("loading branch lowered at high input"),
+        _ if two_sided(x) => {
+            Narrowing::Saturation("loading/unloading difference shrinking towards both ends of a two-sided input")
         }
-        _ => return Reading { effect: c.effect, label: c.label.clone(), narrowing: false },
-    };
-    Reading { effect: "saturation", label: format!("loop narrowing as the input grows ({how})"), narrowing: true }
+        _ => Narrowing::Impossible(why),
+    })
 }
 
 /// Why the fitted candidate is impossible (in words, with the value and its unit), or
@@ -58,14 +81,8 @@ pub fn reading(c: &Candidate, f: &Fitted, n_old: usize, x: &[f64]) -> Reading {
 /// model stepped once per sample lags its own state by up to that much; `x` the input.
 pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64, x: &[f64]) -> Option<String> {
     let coef = f.beta.get(n_old).copied().unwrap_or(0.0);
-    // A direction or loading-branch term narrowing the loop is read as a saturation
-    // ([`reading`]), and so is the squared form on a two-sided field (narrowing towards both
-    // of its ends); on a field of one polarity that form narrows the loop at its low end too.
-    if c.effect == "asymmetry" && !two_sided(x) {
-        let squared = f.terms.get(n_old).filter(|t| t.name == DIRECTION_SQUARED_TERM);
-        if let Some(why) = squared.and_then(|t| narrowing_loop(&t.name, coef, x)) {
-            return Some(why);
-        }
+    if let Some(Narrowing::Impossible(why)) = narrowing(c, f, n_old, x) {
+        return Some(why);
     }
     if c.effect == "inertia" && coef < 0.0 {
         return Some(format!("a negative mass or inertia ({})", crate::numerics::number::num(coef, 4)));
