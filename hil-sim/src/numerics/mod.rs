@@ -1,6 +1,6 @@
 //! Numerical kernels shared by every room: least squares, descriptive statistics,
 //! derivatives of sampled signals, the papers' error metrics, the units of well-known
-//! channel names.
+//! channel names, grids.
 
 pub mod derivative;
 pub mod lstsq;
@@ -19,4 +19,9 @@ pub fn shown(v: f64) -> String {
     } else {
         format!("{v:e}")
     }
+}
+
+/// A log-spaced grid of `n` values from `lo` to `hi` (both > 0).
+pub fn log_spaced(lo: f64, hi: f64, n: usize) -> Vec<f64> {
+    (0..n).map(|k| lo * (hi / lo).powf(k as f64 / (n - 1).max(1) as f64)).collect()
 }

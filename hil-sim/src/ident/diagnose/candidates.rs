@@ -21,6 +21,7 @@ use serde::Serialize;
 
 use super::augment::{Fitted, Term, Transform};
 use crate::ident::fit::Dataset;
+use crate::numerics::log_spaced;
 use crate::numerics::stats::{mean, min_max, std};
 
 /// What an auxiliary channel was taken to be.
@@ -128,7 +129,7 @@ fn frequency_damping(s: &InputStats) -> Candidate {
         effect: "rate_dependence",
         label: "damping growing with the excitation frequency".into(),
         grid_name: Some("window_s".into()),
-        grid: log_grid(lo, hi, n),
+        grid: log_spaced(lo, hi, n),
         build: Box::new(move |w| {
             let term = local_frequency(&x, &dx, dt, w, cap).iter().zip(&dx).map(|(f, d)| f * d).collect();
             Piece { transform: None, terms: vec![Term::additive("c_freq", term)] }
@@ -231,11 +232,6 @@ fn fill(mut v: Vec<f64>) -> Vec<f64> {
     v
 }
 
-/// A log-spaced grid of `n` values from `lo` to `hi`.
-fn log_grid(lo: f64, hi: f64, n: usize) -> Vec<f64> {
-    (0..n).map(|k| lo * (hi / lo).powf(k as f64 / (n - 1).max(1) as f64)).collect()
-}
-
 /// The input's statistics the candidates' grids and terms are built from.
 struct InputStats {
     dt: f64,
@@ -309,7 +305,7 @@ pub fn all(data: &Dataset, aux: &[AuxChannel], input_is_field: bool, rate_band_h
 
 /// Longest field lag tried (s): eddy currents in thick discs, or a coil's L/R behind a current input, reach 0.1–0.2 s.
 const LAG_MAX_S: f64 = 0.3;
-/// Phase (a first-order and a two-pole lag, 1 sample to [`LAG_MAX_S`], and a pure delay, ±30 ms) and amplitude (a
+/// Phase (a first-order and a two-pole lag, 1 sample to [`LAG_MAX_S`], and a pure delay, ±30 ms: [`DELAY_BOX`]) and amplitude (a
 /// saturating map and a zero offset): transforms of the input the base model is fed.
 fn input_transforms(s: &InputStats) -> Vec<Candidate> {
     let dt = s.dt;
@@ -320,21 +316,21 @@ fn input_transforms(s: &InputStats) -> Vec<Candidate> {
     let max_delay = (reach / stride).round();
     let delays: Vec<f64> =
         (-(max_delay as i64)..=max_delay as i64).filter(|k| *k != 0).map(|k| k as f64 * stride * dt).collect();
-    let levels = log_grid(0.6 * s.x_max, 6.0 * s.x_max, 10);
+    let levels = log_spaced(0.6 * s.x_max, 6.0 * s.x_max, 10);
     let offsets: Vec<f64> = (-8..=8).filter(|k| *k != 0).map(|k| f64::from(k) * 0.01 * s.x_span).collect();
     vec![
         transform(
             "field_lag",
             "first-order lag of the input",
             "tau_s",
-            log_grid(dt, LAG_MAX_S.max(4.0 * dt), 20),
+            log_spaced(dt, LAG_MAX_S.max(4.0 * dt), 20),
             |tau| Transform::Lag { tau_s: tau },
         ),
         transform(
             "field_lag",
             "two-pole lag of the input",
             "tau_s",
-            log_grid(2.0 * dt, LAG_MAX_S.max(8.0 * dt), 20),
+            log_spaced(2.0 * dt, LAG_MAX_S.max(8.0 * dt), 20),
             |tau| Transform::Lag2 { tau_s: tau },
         ),
         transform("transport_delay", "time shift between input and output", "delay_s", delays, |d| Transform::Delay {
@@ -361,7 +357,7 @@ fn yield_saturation(data: &Dataset) -> Candidate {
         effect: "saturation",
         label: "saturating torque at high level (yield stress)".into(),
         grid_name: Some("t_sat".into()),
-        grid: log_grid(0.3 * span, 10.0 * span, 12),
+        grid: log_spaced(0.3 * span, 10.0 * span, 12),
         build: Box::new(|t| Piece { transform: None, terms: vec![Term::output_saturation("k_sat", t)] }),
         channel: None,
     }
@@ -504,7 +500,7 @@ fn auxiliary(s: &InputStats, a: &AuxChannel) -> Candidate {
     let dx = s.dx.clone();
     let xc: Vec<f64> = s.x.iter().map(|v| v - s.x_mean).collect();
     let mut grid = vec![0.0];
-    grid.extend(log_grid(dt, (0.05f64).max(4.0 * dt), 10));
+    grid.extend(log_spaced(dt, (0.05f64).max(4.0 * dt), 10));
     Candidate {
         effect: "aux_dependence",
         label: format!("parameters scaled by {}", a.name),
@@ -528,12 +524,16 @@ fn auxiliary(s: &InputStats, a: &AuxChannel) -> Candidate {
     }
 }
 
+/// How far past its grid's ends (±30 ms) a delay is refitted: one near them settles inside
+/// the box, and only one running on past it is pinned at the edge ([`super::physical`]).
+pub const DELAY_BOX: f64 = 1.5;
+
 impl Candidate {
-    /// The box its value is refitted in: its grid's ends.
+    /// The box its value is refitted in: its grid's ends, a delay's [`DELAY_BOX`] times them.
     pub fn bounds(&self) -> (f64, f64) {
+        let k = if self.effect == "transport_delay" { DELAY_BOX } else { 1.0 };
         let lo = self.grid.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = self.grid.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        (lo, hi)
+        (k * lo, k * self.grid.iter().copied().fold(f64::NEG_INFINITY, f64::max))
     }
 
     /// The transforms and terms of `current` with this candidate's piece at value `g` added.

@@ -5,7 +5,10 @@
 //! phase growing less than linearly with frequency. When both effects' terms come within
 //! [`super::replicate::NEAR`] of each other on the tail, the input is given both at once: a
 //! delay of a share `s` of the fitted delay, `s` = 0, ¼, ½, ¾, with the lag (of the lag
-//! candidate's form) tuned on top and θ refitted, and at `s = 1` the delay alone, tuned. The share
+//! candidate's form) tuned on top and θ refitted, and at `s = 1` the delay alone, tuned. The lag
+//! on top of a share may shrink to nothing ([`LAG_FLOOR`]), below the lag candidate's own
+//! shortest (one or two samples): what is left of a delay once most of it is given is shorter
+//! than that at a low sample rate. The share
 //! where the training error is least names the effect: below a half the lag, above it the
 //! delay; at a half the profile does not say, and the reversed split decides
 //! ([`super::accept`]).
@@ -21,6 +24,9 @@ use super::rank::Scored;
 pub const PROFILE_ITERATIONS: usize = 20;
 /// The delay's shares of the profile.
 pub const SHARES: [f64; 5] = [0.0, 0.25, 0.5, 0.75, 1.0];
+/// The shortest lag tuned on top of a share of the delay, as a fraction of the lag
+/// candidate's shortest (a fiftieth of a sample or two: no lag at all, `e^−50`).
+pub const LAG_FLOOR: f64 = 0.02;
 
 /// The profile over the delay's share.
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -80,6 +86,7 @@ pub fn profile(prob: &Problem<'_>, reference: &Fitted, lag: Refitted<'_>, delay:
                 (delay.0, delay_s, &delay.1.fitted.theta)
             };
             let (lo, hi) = c.bounds();
+            let lo = if s < 1.0 { LAG_FLOOR * lo } else { lo };
             let build = |g: f64| {
                 let p = (c.build)(g);
                 (p.transform, p.terms)
@@ -117,8 +124,12 @@ mod tests {
     /// which shares no code with the diagnosis) with `effect` in form `form` at 6 % of the
     /// span.
     fn bench_recording(effect: &str, form: usize, seed: u64) -> Dataset {
+        bench_recording_at(2000.0, effect, form, seed)
+    }
+
+    fn bench_recording_at(fs_hz: f64, effect: &str, form: usize, seed: u64) -> Dataset {
         let c = Case {
-            fs_hz: 2000.0,
+            fs_hz,
             duration_s: 10.0,
             bipolar: false,
             form,
@@ -149,5 +160,17 @@ mod tests {
         let delay = profiled(&bench_recording("transport_delay", 0, 9_100_002));
         assert_eq!(delay.side(), Some(Side::Delay), "{delay:?}");
         assert!(delay.relative_mse.iter().all(|r| *r >= 1.0) && delay.delay_s > 0.0, "{delay:?}");
+    }
+
+    #[test]
+    fn what_is_left_of_a_delay_may_be_shorter_than_the_lag_candidates_grid() {
+        // At 500 Hz the two-pole lag's grid starts at two samples, 4 ms; a delay of a few
+        // milliseconds given three quarters leaves a lag shorter than that to tune on top.
+        let data = bench_recording_at(500.0, "transport_delay", 0, 9_100_003);
+        let shortest = 2.0 * data.dt;
+        let delay = profiled(&data);
+        assert!(delay.delay_s > 0.0 && delay.delay_s < 4.0 * shortest, "{delay:?}");
+        assert!(delay.lag_s[3] < shortest, "{delay:?}");
+        assert_eq!(delay.side(), Some(Side::Delay), "{delay:?}");
     }
 }

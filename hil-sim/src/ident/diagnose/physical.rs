@@ -110,8 +110,7 @@ pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64, 
     if c.grid.len() < 2 {
         return None;
     }
-    let lo = c.grid.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = c.grid.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let (lo, hi) = c.bounds();
     let at = |edge: f64| (value - edge).abs() <= 1e-3 * (hi - lo).abs().max(1e-300);
     match name {
         "tau_s" | "lag_s" if value < 0.0 => Some(format!("a negative time constant ({:.2} ms)", 1e3 * value)),
@@ -166,8 +165,8 @@ fn narrowing_loop(term: &str, coef: f64, x: &[f64]) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ident::diagnose::augment::Term;
-    use crate::ident::diagnose::candidates::Piece;
+    use crate::ident::diagnose::augment::{Term, Transform};
+    use crate::ident::diagnose::candidates::{Piece, DELAY_BOX};
 
     /// The yield-stress candidate, and a model spanning 0–4 N·m refitted with its term at
     /// coefficient `k`.
@@ -281,5 +280,38 @@ mod tests {
         let (r, why) = read(DIRECTION_SQUARED_TERM, -0.3, &positive);
         assert_eq!(r.effect, "asymmetry");
         assert!(why.is_some_and(|w| w.contains("narrowing")));
+    }
+
+    #[test]
+    fn a_delay_past_its_grid_is_refitted_and_pinned_only_at_the_box() {
+        // The grid ±30 ms in 1 ms steps at 1 kHz; the box is DELAY_BOX times that.
+        let c = Candidate {
+            effect: "transport_delay",
+            label: "time shift between input and output".into(),
+            grid_name: Some("delay_s".into()),
+            grid: (-30..=30).filter(|k| *k != 0).map(|k| f64::from(k) * 1e-3).collect(),
+            build: Box::new(|d| Piece { transform: Some(Transform::Delay { delay_s: d }), terms: vec![] }),
+            channel: None,
+        };
+        let (lo, hi) = c.bounds();
+        assert!((lo + 0.03 * DELAY_BOX).abs() < 1e-12 && (hi - 0.03 * DELAY_BOX).abs() < 1e-12, "{lo} {hi}");
+        let f = Fitted {
+            transforms: vec![],
+            terms: vec![],
+            theta: vec![],
+            beta: vec![],
+            model: vec![],
+            pred: vec![],
+            train_mse: 0.0,
+        };
+        let why = |d: f64| impossible(&c, &f, 0, d, 1e-3, &[]);
+        // A delay at the grid's end (the largest a bench or a logger may give) is possible.
+        for d in [0.03, -0.03, 0.0312, 0.04] {
+            assert_eq!(why(d), None, "{d}");
+        }
+        for d in [hi, lo] {
+            assert!(why(d).is_some_and(|w| w.contains("edge of its search range")), "{d}: {:?}", why(d));
+        }
+        assert!(why(0.0004).is_some_and(|w| w.contains("shorter than one sample")));
     }
 }

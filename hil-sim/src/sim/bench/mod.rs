@@ -171,6 +171,11 @@ pub enum Set {
     /// narrowing it towards both ends of a two-sided field, is named a saturation).
     Fresh42,
     Fresh43,
+    /// The forty-fifth and forty-sixth, first run for the fourteenth report of 2026-11-29 (a
+    /// delay is refitted to 1.5 times its ±30 ms grid; the lag on top of a share of the delay
+    /// may shrink below the lag candidate's grid).
+    Fresh44,
+    Fresh45,
 }
 
 impl Set {
@@ -221,6 +226,8 @@ impl Set {
         ("fresh41", Set::Fresh41),
         ("fresh42", Set::Fresh42),
         ("fresh43", Set::Fresh43),
+        ("fresh44", Set::Fresh44),
+        ("fresh45", Set::Fresh45),
     ];
 
     /// The seed of case `k` of this set.
@@ -271,6 +278,8 @@ impl Set {
             Set::Fresh41 => 458_000_000 + 197 * k,
             Set::Fresh42 => 480_000_000 + 199 * k,
             Set::Fresh43 => 502_000_000 + 211 * k,
+            Set::Fresh44 => 524_000_000 + 223 * k,
+            Set::Fresh45 => 546_000_000 + 227 * k,
         }
     }
 }
