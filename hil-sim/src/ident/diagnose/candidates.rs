@@ -305,7 +305,7 @@ pub fn all(data: &Dataset, aux: &[AuxChannel], input_is_field: bool, rate_band_h
 
 /// Longest field lag tried (s): eddy currents in thick discs, or a coil's L/R behind a current input, reach 0.1–0.2 s.
 const LAG_MAX_S: f64 = 0.3;
-/// Phase (a first-order and a two-pole lag, 1 sample to [`LAG_MAX_S`], and a pure delay, ±30 ms: [`DELAY_BOX`]) and amplitude (a
+/// Phase (a first-order and a two-pole lag, 1 sample to [`LAG_MAX_S`], and a pure delay, ±30 ms, refitted to [`DELAY_BOX`] times it) and amplitude (a
 /// saturating map and a zero offset): transforms of the input the base model is fed.
 fn input_transforms(s: &InputStats) -> Vec<Candidate> {
     let dt = s.dt;
