@@ -176,6 +176,10 @@ pub enum Set {
     /// may shrink below the lag candidate's grid).
     Fresh44,
     Fresh45,
+    /// The forty-seventh and forty-eighth, first run for the fifteenth report of 2026-11-29
+    /// (the models' input is smoothed zero-phase at fs/8, not only its rate).
+    Fresh46,
+    Fresh47,
 }
 
 impl Set {
@@ -228,6 +232,8 @@ impl Set {
         ("fresh43", Set::Fresh43),
         ("fresh44", Set::Fresh44),
         ("fresh45", Set::Fresh45),
+        ("fresh46", Set::Fresh46),
+        ("fresh47", Set::Fresh47),
     ];
 
     /// The seed of case `k` of this set.
@@ -280,6 +286,8 @@ impl Set {
             Set::Fresh43 => 502_000_000 + 211 * k,
             Set::Fresh44 => 524_000_000 + 223 * k,
             Set::Fresh45 => 546_000_000 + 227 * k,
+            Set::Fresh46 => 590_000_000 + 229 * k,
+            Set::Fresh47 => 614_000_000 + 233 * k,
         }
     }
 }
