@@ -48,11 +48,8 @@ pub fn rates_below(x: &[f64], dt: f64, cutoff_hz: f64) -> (Vec<f64>, Vec<f64>) {
 /// smoothed again only when the cutoff is lower, so that at fs/8 they are the raw input's
 /// `rates_below` exactly, and a steep rate term sees the rate it always did.
 pub fn rates_of_smoothed(xs: &[f64], dt: f64, cutoff_hz: f64) -> (Vec<f64>, Vec<f64>) {
-    let dx = if cutoff_hz < CUTOFF_OF_FS / dt {
-        gradient(&smooth_below(xs, dt, cutoff_hz), dt)
-    } else {
-        gradient(xs, dt)
-    };
+    let dx =
+        if cutoff_hz < CUTOFF_OF_FS / dt { gradient(&smooth_below(xs, dt, cutoff_hz), dt) } else { gradient(xs, dt) };
     let ddx = gradient(&smooth_below(&dx, dt, cutoff_hz), dt);
     (dx, ddx)
 }
@@ -139,8 +136,9 @@ mod tests {
     fn the_rate_of_a_smoothed_input_is_the_raw_inputs() {
         let dt = 5e-4;
         let step = 2.0 / 4096.0;
-        let x: Vec<f64> =
-            (0..8_000).map(|i| ((0.3 * (40.0 * i as f64 * dt).sin() + 0.001 * ((i * 7919) % 13) as f64) / step).round() * step).collect();
+        let x: Vec<f64> = (0..8_000)
+            .map(|i| ((0.3 * (40.0 * i as f64 * dt).sin() + 0.001 * ((i * 7919) % 13) as f64) / step).round() * step)
+            .collect();
         let top = CUTOFF_OF_FS / dt;
         let xs = smooth_below(&x, dt, top);
         // At fs/8 the very same numbers…

@@ -19,7 +19,9 @@ use crate::ident::fit::Dataset;
 /// [`content_cutoff`]: crate::numerics::derivative::content_cutoff
 /// [`rates_of_smoothed`]: crate::numerics::derivative::rates_of_smoothed
 pub(super) fn models_input(data: &Dataset, opts: &DiagnoseOptions, input: &str) -> (Dataset, f64, Option<String>) {
-    use crate::numerics::derivative::{content_cutoff, rates_of_smoothed, smooth_below, CUTOFF_OF_CONTENT, CUTOFF_OF_FS};
+    use crate::numerics::derivative::{
+        content_cutoff, rates_of_smoothed, smooth_below, CUTOFF_OF_CONTENT, CUTOFF_OF_FS,
+    };
     let mut data = data.clone();
     let top = CUTOFF_OF_FS / data.dt;
     if opts.rate.is_some() {
@@ -68,7 +70,12 @@ mod tests {
             .collect();
         let (smoothed, _, _) = models_input(&data, &DiagnoseOptions::default(), "b");
         for i in [n - 1, n, n + 1] {
-            assert!((smoothed.input[i] - data.input[i]).abs() < 2e-3, "sample {i}: {} for {}", smoothed.input[i], data.input[i]);
+            assert!(
+                (smoothed.input[i] - data.input[i]).abs() < 2e-3,
+                "sample {i}: {} for {}",
+                smoothed.input[i],
+                data.input[i]
+            );
         }
         // …and smooths: the sine's 40 rad/s is kept, a sample-to-sample alternation is not.
         let mut noisy = data.clone();
