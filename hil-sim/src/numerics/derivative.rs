@@ -38,27 +38,11 @@ pub fn rates(x: &[f64], dt: f64) -> (Vec<f64>, Vec<f64>) {
 
 /// [`rates`] smoothed at `cutoff_hz` instead (at most [`CUTOFF_OF_FS`] of the sampling rate).
 pub fn rates_below(x: &[f64], dt: f64, cutoff_hz: f64) -> (Vec<f64>, Vec<f64>) {
-    let dx = gradient(&smooth_below(x, dt, cutoff_hz), dt);
-    let ddx = gradient(&smooth_below(&dx, dt, cutoff_hz), dt);
-    (dx, ddx)
-}
-
-/// The rate and acceleration of `xs`, an input already smoothed at [`CUTOFF_OF_FS`] of the
-/// sampling rate ([`smooth_below`]), as [`rates_below`] of the raw input at `cutoff_hz`:
-/// smoothed again only when the cutoff is lower, so that at fs/8 they are the raw input's
-/// `rates_below` exactly, and a steep rate term sees the rate it always did.
-pub fn rates_of_smoothed(xs: &[f64], dt: f64, cutoff_hz: f64) -> (Vec<f64>, Vec<f64>) {
-    let dx =
-        if cutoff_hz < CUTOFF_OF_FS / dt { gradient(&smooth_below(xs, dt, cutoff_hz), dt) } else { gradient(xs, dt) };
-    let ddx = gradient(&smooth_below(&dx, dt, cutoff_hz), dt);
-    (dx, ddx)
-}
-
-/// `x` (sampled every `dt` s) through the zero-phase low-pass of [`rates_below`] at
-/// `cutoff_hz` (at most [`CUTOFF_OF_FS`] of the sampling rate).
-pub fn smooth_below(x: &[f64], dt: f64, cutoff_hz: f64) -> Vec<f64> {
     let share = (cutoff_hz * dt).clamp(1e-6, CUTOFF_OF_FS);
-    filtfilt(x, 1.0 / (2.0 * std::f64::consts::PI * share))
+    let tau = 1.0 / (2.0 * std::f64::consts::PI * share);
+    let dx = gradient(&filtfilt(x, tau), dt);
+    let ddx = gradient(&filtfilt(&dx, tau), dt);
+    (dx, ddx)
 }
 
 /// The zero-phase rate's cutoff is at least this multiple of [`content_frequency`]: the
@@ -131,25 +115,6 @@ pub fn gradient(v: &[f64], dt: f64) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn the_rate_of_a_smoothed_input_is_the_raw_inputs() {
-        let dt = 5e-4;
-        let step = 2.0 / 4096.0;
-        let x: Vec<f64> = (0..8_000)
-            .map(|i| ((0.3 * (40.0 * i as f64 * dt).sin() + 0.001 * ((i * 7919) % 13) as f64) / step).round() * step)
-            .collect();
-        let top = CUTOFF_OF_FS / dt;
-        let xs = smooth_below(&x, dt, top);
-        // At fs/8 the very same numbers…
-        assert_eq!(rates_of_smoothed(&xs, dt, top), rates_below(&x, dt, top));
-        // …and below it the raw input's rate within a part in a hundred of its amplitude.
-        let x: Vec<f64> = (0..8_000).map(|i| 0.3 * (40.0 * i as f64 * dt).sin()).collect();
-        let xs = smooth_below(&x, dt, top);
-        let (a, b) = (rates_of_smoothed(&xs, dt, 60.0).0, rates_below(&x, dt, 60.0).0);
-        let worst = (200..7_800).map(|i| (a[i] - b[i]).abs()).fold(0.0, f64::max);
-        assert!(worst < 0.01 * 0.3 * 40.0, "{worst} T/s apart");
-    }
 
     #[test]
     fn the_cutoff_follows_the_content_and_quiets_a_quantised_rate() {

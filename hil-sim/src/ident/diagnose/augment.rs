@@ -368,13 +368,12 @@ impl<'a> Problem<'a> {
 
     /// The base model's kinematics for the (transformed) input `x`.
     pub(super) fn kin_of(&self, x: &[f64]) -> Option<Vec<model_core::Kin>> {
-        // Given rates are the zero-phase ones of the smoothed input: recomputed for the
-        // transformed input.
+        // Given rates are the zero-phase ones: recomputed for the transformed input.
         let rates = self
             .data
             .rates
             .as_ref()
-            .map(|_| crate::numerics::derivative::rates_of_smoothed(x, self.data.dt, self.rate_cutoff_hz));
+            .map(|_| crate::numerics::derivative::rates_below(x, self.data.dt, self.rate_cutoff_hz));
         let samples = crate::models::replay::samples_with_rates(x, self.data.command.as_deref(), rates.as_ref());
         kinematics(&samples, self.data.dt as f32, self.rate)
     }

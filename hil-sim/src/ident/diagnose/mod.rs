@@ -4,8 +4,7 @@
 //!
 //! 1. **Base** ([`base`]). The base model is fitted on the training part (the first
 //!    `1 − heldout_fraction`) with the channels as recorded (no delay fitted: a time shift
-//!    between channels is a finding, not something to absorb silently; the input and its rate
-//!    smoothed zero-phase, [`smoothing`]). `auto` fits every
+//!    between channels is a finding, not something to absorb silently). `auto` fits every
 //!    seed model ([`AUTO_BASES`]); the structurally different ones close to the best, and the
 //!    algebraic model with play operators, each get the first round, and the base whose first
 //!    round predicts the held-out part best is kept ([`contenders`]). A static power-law term of
@@ -56,7 +55,6 @@ pub mod refit;
 pub mod replicate;
 pub mod scan;
 pub mod significance;
-pub mod smoothing;
 
 use std::time::Instant;
 
@@ -117,8 +115,7 @@ fn diagnose_at_rate(
     let started = Instant::now();
     // Without a chosen estimator the models get the zero-phase rate: a causal estimator's
     // lag would otherwise be diagnosed as the clutch's.
-    let recorded = data;
-    let (data, rate_cutoff_hz, rate_note) = smoothing::models_input(data, opts, names.0);
+    let (data, rate_cutoff_hz, rate_note) = with_zero_phase_rate(data, opts, names.0);
     let data = &data;
     let bases = base::choices(opts);
     progress.stage("diagnosing", (bases.len() + 2 + 2 * opts.max_findings) as u64);
@@ -223,7 +220,7 @@ fn diagnose_at_rate(
         notes,
         units: (unit_of(names.0).unwrap_or("").to_owned(), unit_of(names.1).unwrap_or("").to_owned()),
         seconds: started.elapsed().as_secs_f64(),
-        plot: plot_data(recorded, before, current.pred, held),
+        plot: plot_data(data, before, current.pred, held),
     })
 }
 
@@ -240,6 +237,29 @@ fn plot_data(data: &Dataset, before: Vec<f64>, after: Vec<f64>, held: Vec<usize>
         heldout_rows: held,
         fs: 1.0 / data.dt,
     }
+}
+
+/// `data` with the models' zero-phase rate at [`crate::numerics::derivative::content_cutoff`]
+/// (unless `opts` chose an estimator), that cutoff (Hz), and the note saying so when it is
+/// below fs/8 (`input`: the input channel's name).
+fn with_zero_phase_rate(data: &Dataset, opts: &DiagnoseOptions, input: &str) -> (Dataset, f64, Option<String>) {
+    use crate::numerics::derivative::{content_cutoff, rates_below, CUTOFF_OF_CONTENT, CUTOFF_OF_FS};
+    let mut data = data.clone();
+    let top = CUTOFF_OF_FS / data.dt;
+    if opts.rate.is_some() {
+        // The models use the chosen estimator: no given rates, so the cutoff is never read.
+        return (data, top, None);
+    }
+    let cutoff = content_cutoff(&data.input, data.dt);
+    data.rates = Some(rates_below(&data.input, data.dt, cutoff));
+    let note = (cutoff < top).then(|| {
+        format!(
+            "the models' rate of {input} was smoothed (zero phase) at {cutoff:.0} Hz, not {top:.0} Hz: 99.9 % of \
+             {input}'s power lies below {:.1} Hz, and the band above it only adds the reading's noise to the rate",
+            cutoff / CUTOFF_OF_CONTENT
+        )
+    });
+    (data, cutoff, note)
 }
 
 /// The kept candidate `k` (read as `effect`) and every candidate of that effect on its
@@ -452,43 +472,6 @@ mod tests {
         let d = diagnose(&data, vec![], None, ("b", "torque"), &opts, &crate::progress::NoProgress).unwrap();
         assert!(d.findings.is_empty(), "{:#?}", d.findings);
         assert!(d.notes.iter().any(|n| n.contains("smoothed (zero phase)")), "{:?}", d.notes);
-    }
-
-    #[test]
-    fn a_dahl_loop_read_through_a_12_bit_hall_is_not_a_lag() {
-        // A Dahl loop (LuGre's own equations, stepped here in f64 with four Euler sub-steps)
-        // under band-limited noise at 2 kHz, its field read by a 12-bit ADC over ±1 T with
-        // half a count of noise. Fed raw to LuGre, the reading's steps went back and forth
-        // and wore the loop's state down; a lag of the input, which smooths them, gained
-        // about a fifth of the held-out error and was named (fresh40/44/45's Dahl nulls).
-        let mut rng = rand::rngs::StdRng::seed_from_u64(23);
-        let (dt, n) = (5e-4, 40_000);
-        let b: Vec<f64> = band_limited(&mut rng, n, dt, 6.0).iter().map(|v| 0.3 + 0.25 * v).collect();
-        let db = crate::numerics::derivative::gradient(&b, dt);
-        let mut z = 0.0f64;
-        let y: Vec<f64> = b
-            .iter()
-            .zip(&db)
-            .map(|(b, d)| {
-                for _ in 0..4 {
-                    z += dt / 4.0 * 15.0 * (d - d.abs() * z);
-                }
-                0.5 + 21.0 * b + 1.5 * z + 0.012 * d
-            })
-            .collect();
-        let step = 2.0 / 4096.0;
-        let read: Vec<f64> = b
-            .iter()
-            .map(|v| ((v + 0.5 * step * (rng.random::<f64>() - 0.5) * 12f64.sqrt()) / step).round() * step)
-            .collect();
-        let mut data = with_noise(read.clone(), &y, &mut rng);
-        data.dt = dt;
-        data.time = (0..n).map(|i| i as f64 * dt).collect();
-        let opts = DiagnoseOptions { model: Some("lugre".into()), ..Default::default() };
-        let d = diagnose(&data, vec![], None, ("b", "torque"), &opts, &crate::progress::NoProgress).unwrap();
-        assert!(d.findings.is_empty(), "{:#?}", d.findings);
-        // The report plots the field as read, not as the models were fed it.
-        assert_eq!(d.plot.input, read);
     }
 
     #[test]

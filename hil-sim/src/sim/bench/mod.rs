@@ -177,7 +177,8 @@ pub enum Set {
     Fresh44,
     Fresh45,
     /// The forty-seventh and forty-eighth, first run for the fifteenth report of 2026-11-29
-    /// (the models' input is smoothed zero-phase at fs/8, not only its rate).
+    /// with the models' input smoothed zero-phase at fs/8 (tried and not taken: figures in
+    /// docs/diagnose.md).
     Fresh46,
     Fresh47,
 }
