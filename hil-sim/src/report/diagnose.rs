@@ -223,7 +223,15 @@ fn outcome(c: &Tested) -> String {
         (_, true) => "kept".into(),
         (Some(why), false) => format!("not possible: {why}"),
         (None, false) if c.named_before => format!("not kept: read as {}, named in an earlier round", c.effect),
-        (None, false) => String::new(),
+        (None, false) => match c.zero_phase.filter(|z| !z.passed) {
+            Some(z) => format!(
+                "not kept: no better than the input smoothed without a lag's phase (τ = {:.3} ms; t = {:.1}, gain {:.1} %)",
+                1e3 * z.tau_s,
+                z.test.t,
+                100.0 * z.test.gain
+            ),
+            None => String::new(),
+        },
     }
 }
 
@@ -348,10 +356,21 @@ mod tests {
             replication: None,
             lag_or_delay: None,
             acting: None,
+            zero_phase: None,
         };
         assert_eq!(outcome(&c), "not possible: a loop narrowing as the input grows (delta = -1.2)");
         c.impossible = None;
         assert_eq!(outcome(&c), "");
+        c.zero_phase = Some(crate::ident::diagnose::zero_phase::Control {
+            tau_s: 0.0021,
+            test: Test { t: 1.2, gain: 0.012, blocks_better: 6, blocks: 10, p_rank: 0.2, significant: false },
+            passed: false,
+        });
+        assert_eq!(
+            outcome(&c),
+            "not kept: no better than the input smoothed without a lag's phase (τ = 2.100 ms; t = 1.2, gain 1.2 %)"
+        );
+        c.zero_phase = None;
         c.named_before = true;
         c.effect = "saturation".into();
         assert_eq!(outcome(&c), "not kept: read as saturation, named in an earlier round");

@@ -18,6 +18,7 @@ use super::physical::Reading;
 use super::rank::Scored;
 use super::replicate::{self, Replication, Reversed};
 use super::significance::{self, Test};
+use super::zero_phase;
 use crate::numerics::metrics::{metrics, Metrics};
 
 /// What a candidate is judged on: the recorded output, its held-out rows (the test), every
@@ -118,29 +119,43 @@ impl Judge<'_> {
                 replication: None,
                 lag_or_delay: None,
                 acting: None,
+                zero_phase: None,
             });
             let quiet = fits && tail_share < acting::QUIET_TAIL;
             let significant = test.significant;
             judged.push(Judged { otherwise, significant, quiet, tail_share, scored: s, test, after, reading });
         }
         let reversed = Reversed::new(prob, reference);
-        let replicate = |k: usize| {
-            let s = &judged[k].scored;
-            let tail = significance::blocks(self.y, &reference.pred, &s.fitted.pred, self.held);
-            reversed.replicate(&cands[s.index], s, &tail)
-        };
-        let effect = |k: usize| judged[k].reading.effect;
-        let mixture = |lag: usize, delay: usize| {
-            let (l, d) = (&judged[lag].scored, &judged[delay].scored);
-            lag_or_delay::profile(prob, reference, (&cands[l.index], l), (&cands[d.index], d))
-        };
-        let best = choose(&judged, &mut tested, Ties { replicate, mixture, effect }).or_else(|| {
-            let act = |k: usize| {
-                let j = &judged[k];
-                acting::acting(prob, reference, &cands[j.scored.index], &j.scored, j.tail_share)
+        // Candidates barred from being kept: a field lag that did not beat its zero-phase
+        // control bars every field lag of the round, and the round chooses again.
+        let mut barred = vec![false; judged.len()];
+        let best = loop {
+            let replicate = |k: usize| {
+                let s = &judged[k].scored;
+                let tail = significance::blocks(self.y, &reference.pred, &s.fitted.pred, self.held);
+                reversed.replicate(&cands[s.index], s, &tail)
             };
-            where_it_acts(&judged, &mut tested, act)
-        });
+            let effect = |k: usize| judged[k].reading.effect;
+            let mixture = |lag: usize, delay: usize| {
+                let (l, d) = (&judged[lag].scored, &judged[delay].scored);
+                lag_or_delay::profile(prob, reference, (&cands[l.index], l), (&cands[d.index], d))
+            };
+            let best = choose(&judged, &barred, &mut tested, Ties { replicate, mixture, effect }).or_else(|| {
+                let act = |k: usize| {
+                    let j = &judged[k];
+                    acting::acting(prob, reference, &cands[j.scored.index], &j.scored, j.tail_share)
+                };
+                where_it_acts(&judged, &barred, &mut tested, act)
+            });
+            let Some(k) = best.filter(|&k| effect(k) == "field_lag") else { break best };
+            tested[k].zero_phase = zero_phase::control(prob, reference, &judged[k].scored, self.y, self.held);
+            if tested[k].zero_phase.is_none_or(|c| c.passed) {
+                break best;
+            }
+            for (b, j) in barred.iter_mut().zip(&judged) {
+                *b |= j.reading.effect == "field_lag";
+            }
+        };
         let accepted = best.map(|k| {
             tested[k].kept = true;
             let (replication, lag_or_delay, acting) = (tested[k].replication, tested[k].lag_or_delay, tested[k].acting);
@@ -178,7 +193,7 @@ struct Ties<R, M, E> {
 /// error; when other effects' eligible candidates (`effect`) come within
 /// [`replicate::NEAR`] of it, the one the lag and the delay given together name when the tie
 /// is between those two ([`lag_or_delay`]), else the one of them all with the best pooled gain.
-fn choose<R, M, E>(judged: &[Judged], tested: &mut [Tested], ties: Ties<R, M, E>) -> Option<usize>
+fn choose<R, M, E>(judged: &[Judged], barred: &[bool], tested: &mut [Tested], ties: Ties<R, M, E>) -> Option<usize>
 where
     R: Fn(usize) -> Option<Replication>,
     M: Fn(usize, usize) -> Option<Mixture>,
@@ -186,12 +201,11 @@ where
 {
     let Ties { replicate, mixture, effect } = ties;
     let by_error = |a: &usize, b: &usize| judged[*a].after.rmse.total_cmp(&judged[*b].after.rmse);
-    let mut eligible: Vec<usize> =
-        (0..judged.len()).filter(|&k| judged[k].otherwise && judged[k].significant).collect();
+    let open = |k: &usize| judged[*k].otherwise && !barred[*k];
+    let mut eligible: Vec<usize> = (0..judged.len()).filter(open).filter(|&k| judged[k].significant).collect();
     let bar = eligible.iter().min_by(|a, b| by_error(a, b)).map_or(f64::INFINITY, |&k| judged[k].after.rmse);
-    let mut undecided: Vec<usize> = (0..judged.len())
-        .filter(|&k| judged[k].otherwise && !judged[k].significant && judged[k].after.rmse < bar)
-        .collect();
+    let mut undecided: Vec<usize> =
+        (0..judged.len()).filter(open).filter(|&k| !judged[k].significant && judged[k].after.rmse < bar).collect();
     undecided.sort_by(by_error);
     for k in undecided.into_iter().take(replicate::MAX_TRIED) {
         tested[k].replication = replicate(k);
@@ -237,8 +251,13 @@ where
 
 /// When a round keeps nothing: of the candidates the tail barely excites, the first (by
 /// training gain) that passes on the split where it acts (`act`, recorded in `tested`).
-fn where_it_acts(judged: &[Judged], tested: &mut [Tested], act: impl Fn(usize) -> Option<Acting>) -> Option<usize> {
-    let mut quiet: Vec<usize> = (0..judged.len()).filter(|&k| judged[k].quiet).collect();
+fn where_it_acts(
+    judged: &[Judged],
+    barred: &[bool],
+    tested: &mut [Tested],
+    act: impl Fn(usize) -> Option<Acting>,
+) -> Option<usize> {
+    let mut quiet: Vec<usize> = (0..judged.len()).filter(|&k| judged[k].quiet && !barred[k]).collect();
     quiet.sort_by(|a, b| judged[*b].scored.bic_gain.total_cmp(&judged[*a].scored.bic_gain));
     for k in quiet.into_iter().take(acting::MAX_TRIED) {
         tested[k].acting = act(k);

@@ -22,11 +22,11 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
+use super::projection::{self, Projection};
 use crate::ident::fit::simulate::{kinematics, Simulator};
 use crate::ident::fit::Dataset;
 use crate::models::search::{ModelSpec, Spacing};
 use crate::models::RateSpec;
-use crate::numerics::lstsq::{self, dot};
 
 /// A change to what the base model is fed.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -46,6 +46,9 @@ pub enum Transform {
     SaturateKnee { b_sat: f64 },
     /// The recorded input reads `b_0` high: the model sees `x − b_0`.
     Offset { b_0: f64 },
+    /// First-order lags of `τ` forward and backward in time: the input smoothed without a
+    /// shift of phase. Never a finding: the control a field lag must beat ([`super::zero_phase`]).
+    Smooth { tau_s: f64 },
 }
 
 impl Transform {
@@ -70,6 +73,14 @@ impl Transform {
             Self::Saturate { b_sat } => x.iter().map(|v| b_sat * (v / b_sat).tanh()).collect(),
             Self::SaturateKnee { b_sat } => x.iter().map(|v| v / (1.0 + (v / b_sat).powi(4)).powf(0.25)).collect(),
             Self::Offset { b_0 } => x.iter().map(|v| v - b_0).collect(),
+            Self::Smooth { tau_s } => {
+                let lag = Self::Lag { tau_s };
+                let mut f = lag.apply(x, dt);
+                f.reverse();
+                let mut b = lag.apply(&f, dt);
+                b.reverse();
+                b
+            }
         }
     }
 }
@@ -118,7 +129,10 @@ impl InputMap {
         match self {
             Self::Play { .. } => true,
             Self::LevelPower { .. } => {
-                matches!(t, Transform::Delay { .. } | Transform::Lag { .. } | Transform::Lag2 { .. })
+                matches!(
+                    t,
+                    Transform::Delay { .. } | Transform::Lag { .. } | Transform::Lag2 { .. } | Transform::Smooth { .. }
+                )
             }
         }
     }
@@ -250,8 +264,8 @@ struct AugSim<'p, 'a> {
 /// Tuning values whose kinematics an [`AugSim`] keeps.
 const CACHED: usize = 2;
 
-/// Kinematics, transforms and terms at one tuning value.
-type Piece = (Vec<model_core::Kin>, Vec<Transform>, Vec<Term>);
+/// Kinematics, transforms, terms and their least squares at one tuning value.
+type Piece = (Vec<model_core::Kin>, Vec<Transform>, Vec<Term>, Projection);
 type CachedPiece = (u64, std::sync::Arc<Piece>);
 /// Base output, β, prediction, its mean squared error, transforms and terms (`AugSim::full`).
 type Full = (Vec<f64>, Vec<f64>, Vec<f64>, f64, Vec<Transform>, Vec<Term>);
@@ -277,7 +291,8 @@ impl AugSim<'_, '_> {
         let x = self.prob.transformed(&transforms);
         let kin = self.prob.kin_of(&x)?;
         let terms = self.prob.through(terms, &transforms, &x);
-        let v = std::sync::Arc::new((kin, transforms, terms));
+        let projection = self.prob.projection(&terms);
+        let v = std::sync::Arc::new((kin, transforms, terms, projection));
         if let Ok(mut c) = self.cache.lock() {
             c.insert(0, (g.to_bits(), std::sync::Arc::clone(&v)));
             c.truncate(CACHED);
@@ -289,9 +304,9 @@ impl AugSim<'_, '_> {
         let theta = p.get(..self.n_base())?;
         let g = p.get(self.n_base()).copied().unwrap_or(0.0);
         let piece = self.at(g)?;
-        let (kin, transforms, terms) = &*piece;
+        let (kin, transforms, terms, projection) = &*piece;
         let m = self.prob.run_kin(theta, kin)?;
-        let (beta, pred, mse) = self.prob.solve_terms(terms, &m)?;
+        let (beta, pred, mse) = self.prob.solve_terms(terms, projection, &m, true)?;
         Some((m, beta, pred, mse, transforms.clone(), terms.clone()))
     }
 }
@@ -313,9 +328,9 @@ impl Simulator for AugSim<'_, '_> {
         else {
             return false;
         };
-        let (kin, _, terms) = &*piece;
+        let (kin, _, terms, projection) = &*piece;
         let Some(m) = kin.get(..out.len()).and_then(|k| self.prob.run_kin(theta, k)) else { return false };
-        let Some((_, pred, _)) = self.prob.solve_terms(terms, &m) else { return false };
+        let Some((_, pred, _)) = self.prob.solve_terms(terms, projection, &m, false) else { return false };
         for (o, v) in out.iter_mut().zip(&pred) {
             *o = *v;
         }
@@ -404,53 +419,31 @@ impl<'a> Problem<'a> {
             .collect()
     }
 
-    /// Least squares of `target` on `columns` over `rows`: coefficients and the training MSE.
-    /// Columns are scaled to unit norm and the normal equations get a tiny ridge, so a
-    /// column that duplicates another costs nothing instead of breaking the solve.
-    pub fn lsq(&self, columns: &[&[f64]], target: &[f64], rows: &[usize]) -> Option<(Vec<f64>, f64)> {
-        let n = rows.len().max(1) as f64;
-        let on_rows = |c: &[f64]| -> Vec<f64> { rows.iter().map(|&i| c[i]).collect() };
-        let t = on_rows(target);
-        if columns.is_empty() {
-            return Some((Vec::new(), dot(&t, &t) / n));
-        }
-        // The columns on the rows, each scaled to unit norm, and their norms.
-        let scaled: Vec<(Vec<f64>, f64)> = columns
-            .iter()
-            .map(|c| {
-                let v = on_rows(c);
-                let s = dot(&v, &v).sqrt();
-                let s = if s > 0.0 && s.is_finite() { s } else { 1.0 };
-                (v.into_iter().map(|x| x / s).collect(), s)
-            })
-            .collect();
-        // The normal equations from column products (vectorised), with the ridge.
-        let cols: Vec<&[f64]> = scaled.iter().map(|(c, _)| c.as_slice()).collect();
-        let mut g = lstsq::gram(&cols);
-        for a in 0..cols.len() {
-            g[(a, a)] += 1e-10;
-        }
-        let b = nalgebra::DVector::<f64>::from_fn(cols.len(), |a, _| dot(cols[a], &t));
-        let sol = lstsq::solve_cholesky(g, &b, 1e-12)?;
-        let coef: Vec<f64> = sol.iter().zip(&scaled).map(|(v, (_, s))| v / s).collect();
-        if coef.iter().any(|v| !v.is_finite()) {
-            return None;
-        }
-        let mut r = t;
-        for ((c, _), w) in scaled.iter().zip(sol.iter()) {
-            for (r, c) in r.iter_mut().zip(c) {
-                *r -= w * c;
-            }
-        }
-        Some((coef, dot(&r, &r) / n))
+    /// The least squares of `terms` on the training rows, their additive columns prepared.
+    fn projection(&self, terms: &[Term]) -> Projection {
+        let fixed: Vec<Option<&[f64]>> =
+            terms.iter().map(|t| matches!(t.kind, TermKind::Additive).then_some(t.values.as_slice())).collect();
+        Projection::new(&fixed, &self.train)
     }
 
-    /// β for fixed θ (model output `m`): least squares of `y − m` on the terms' columns.
-    fn solve_terms(&self, terms: &[Term], m: &[f64]) -> Option<(Vec<f64>, Vec<f64>, f64)> {
+    /// β for fixed θ (model output `m`): least squares of `y − m` on the terms' columns
+    /// (`projection`: the terms' own); the prediction, and the training MSE when `with_mse`
+    /// (NaN otherwise).
+    fn solve_terms(
+        &self,
+        terms: &[Term],
+        projection: &Projection,
+        m: &[f64],
+        with_mse: bool,
+    ) -> Option<(Vec<f64>, Vec<f64>, f64)> {
         let cols: Vec<std::borrow::Cow<'_, [f64]>> = terms.iter().map(|t| t.column(m)).collect();
-        let target: Vec<f64> = self.data.output.iter().zip(m).map(|(y, m)| y - m).collect();
-        let refs: Vec<&[f64]> = cols.iter().map(|c| &**c).collect();
-        let (beta, mse) = self.lsq(&refs, &target, &self.train)?;
+        let varying: Vec<&[f64]> =
+            terms.iter().zip(&cols).filter(|(t, _)| !matches!(t.kind, TermKind::Additive)).map(|(_, c)| &**c).collect();
+        let (beta, mse) = if with_mse {
+            projection.fit_for(&varying, &self.data.output, m)?
+        } else {
+            (projection.coefficients_for(&varying, &self.data.output, m)?, f64::NAN)
+        };
         let mut pred = m.to_vec();
         for (c, b) in cols.iter().zip(&beta) {
             for (p, v) in pred.iter_mut().zip(c.iter()) {
@@ -524,7 +517,7 @@ impl<'a> Problem<'a> {
         let term_cols: Vec<std::borrow::Cow<'_, [f64]>> = terms.iter().map(|t| t.column(&m)).collect();
         let cols: Vec<&[f64]> = jac.iter().map(Vec::as_slice).chain(term_cols.iter().map(|c| &**c)).collect();
         let target: Vec<f64> = self.data.output.iter().zip(&m).map(|(y, m)| y - m).collect();
-        self.lsq(&cols, &target, &self.train).map(|(_, mse)| mse)
+        projection::lsq(&cols, &target, &self.train).map(|(_, mse)| mse)
     }
 
     /// The base model's Jacobian at `theta` through `transforms`.

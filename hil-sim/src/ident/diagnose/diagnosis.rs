@@ -99,6 +99,10 @@ pub struct Tested {
     /// The split where it acts, when the tail barely excited it ([`super::acting`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub acting: Option<Acting>,
+    /// A field lag against the input smoothed without its phase, when it was to be kept
+    /// ([`super::zero_phase`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub zero_phase: Option<super::zero_phase::Control>,
 }
 
 /// The whole diagnosis.

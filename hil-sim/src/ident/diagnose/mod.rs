@@ -50,11 +50,13 @@ pub mod locate;
 pub mod options;
 pub mod physical;
 pub mod profile;
+pub mod projection;
 pub mod rank;
 pub mod refit;
 pub mod replicate;
 pub mod scan;
 pub mod significance;
+pub mod zero_phase;
 
 use std::time::Instant;
 

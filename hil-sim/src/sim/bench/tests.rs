@@ -17,7 +17,7 @@ fn every_effect_and_form_reaches_its_size_on_every_family() {
 #[test]
 fn the_sets_do_not_share_seeds_and_cover_everything() {
     let seeds: Vec<Vec<u64>> =
-        Set::NAMED.iter().map(|(_, s)| cases(*s, 300, 60).iter().map(|c| c.seed).collect()).collect();
+        Set::NAMED.iter().map(|(_, s, _, _)| cases(*s, 300, 60).iter().map(|c| c.seed).collect()).collect();
     for (i, a) in seeds.iter().enumerate() {
         for b in &seeds[i + 1..] {
             assert!(a.iter().all(|s| !b.contains(s)), "two sets share a seed");

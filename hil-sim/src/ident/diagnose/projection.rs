@@ -1,0 +1,177 @@
+//! The least squares inside every refit (variable projection): the terms' coefficients β
+//! for fixed θ, on the training rows. Columns are scaled to unit norm and the normal
+//! equations get a tiny ridge, so a column that duplicates another costs nothing instead of
+//! breaking the solve.
+//!
+//! A refit's Levenberg–Marquardt solves it once per run of the base model (one per free
+//! parameter for every Jacobian), and most columns (the additive terms) do not change
+//! between those runs: a [`Projection`] gathers and scales them once, with their products,
+//! and every solve computes only what depends on the base model's output. The arithmetic is
+//! the same, in the same order, as solving from scratch ([`lsq`]).
+
+use crate::numerics::lstsq::{self, dot};
+
+/// A column on the rows, scaled to unit norm, and the norm it was divided by.
+struct Scaled {
+    values: Vec<f64>,
+    norm: f64,
+}
+
+impl Scaled {
+    fn new(column: &[f64], rows: &[usize]) -> Self {
+        let v: Vec<f64> = rows.iter().map(|&i| column[i]).collect();
+        let s = dot(&v, &v).sqrt();
+        let norm = if s > 0.0 && s.is_finite() { s } else { 1.0 };
+        Self { values: v.into_iter().map(|x| x / norm).collect(), norm }
+    }
+}
+
+/// Least squares on fixed rows whose fixed columns are prepared once.
+pub struct Projection {
+    rows: Vec<usize>,
+    /// One entry per column: `Some` for a fixed column (gathered and scaled), `None` for
+    /// one given at every solve.
+    fixed: Vec<Option<Scaled>>,
+    /// Products of the fixed columns' pairs (row-major, `k × k`; `None` where either varies).
+    products: Vec<Option<f64>>,
+}
+
+impl Projection {
+    /// `columns`: `Some(values)` for a column that stays the same across solves (indexed by
+    /// row, like the target), `None` for one given to every solve.
+    pub fn new(columns: &[Option<&[f64]>], rows: &[usize]) -> Self {
+        let fixed: Vec<Option<Scaled>> = columns.iter().map(|c| c.map(|c| Scaled::new(c, rows))).collect();
+        let k = fixed.len();
+        let mut products = vec![None; k * k];
+        for a in 0..k {
+            for b in a..k {
+                if let (Some(x), Some(y)) = (&fixed[a], &fixed[b]) {
+                    products[a * k + b] = Some(dot(&x.values, &y.values));
+                }
+            }
+        }
+        Self { rows: rows.to_vec(), fixed, products }
+    }
+
+    /// Coefficients of the columns for `target` (indexed by row) and the scaled solution's
+    /// residual on the rows when `with_mse`. `varying`: the columns prepared as `None`, in
+    /// their order. `None` when a column is missing or the solve fails.
+    fn solve(&self, varying: &[&[f64]], target: &[f64], with_mse: bool) -> Option<(Vec<f64>, f64)> {
+        let t: Vec<f64> = self.rows.iter().map(|&i| target[i]).collect();
+        self.solve_on_rows(varying, t, with_mse)
+    }
+
+    /// As [`Projection::solve`], the target already gathered on the rows.
+    fn solve_on_rows(&self, varying: &[&[f64]], t: Vec<f64>, with_mse: bool) -> Option<(Vec<f64>, f64)> {
+        let n = self.rows.len().max(1) as f64;
+        let k = self.fixed.len();
+        if k == 0 {
+            return Some((Vec::new(), dot(&t, &t) / n));
+        }
+        let mut given = varying.iter();
+        let made: Vec<Option<Scaled>> = self
+            .fixed
+            .iter()
+            .map(|f| match f {
+                Some(_) => Some(None),
+                None => given.next().map(|c| Some(Scaled::new(c, &self.rows))),
+            })
+            .collect::<Option<_>>()?;
+        let cols: Vec<&Scaled> = self.fixed.iter().zip(&made).filter_map(|(f, m)| f.as_ref().or(m.as_ref())).collect();
+        // The normal equations from column products (prepared where both are fixed), ridged.
+        let mut g = nalgebra::DMatrix::<f64>::zeros(k, k);
+        for a in 0..k {
+            for b in a..k {
+                let v = self.products[a * k + b].unwrap_or_else(|| dot(&cols[a].values, &cols[b].values));
+                g[(a, b)] = v;
+                g[(b, a)] = v;
+            }
+        }
+        for a in 0..k {
+            g[(a, a)] += 1e-10;
+        }
+        let rhs = nalgebra::DVector::<f64>::from_fn(k, |a, _| dot(&cols[a].values, &t));
+        let sol = lstsq::solve_cholesky(g, &rhs, 1e-12)?;
+        let coef: Vec<f64> = sol.iter().zip(&cols).map(|(v, c)| v / c.norm).collect();
+        if coef.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        if !with_mse {
+            return Some((coef, f64::NAN));
+        }
+        let mut r = t;
+        for (c, w) in cols.iter().zip(sol.iter()) {
+            for (r, c) in r.iter_mut().zip(&c.values) {
+                *r -= w * c;
+            }
+        }
+        Some((coef, dot(&r, &r) / n))
+    }
+
+    /// Coefficients and the mean squared residual on the rows.
+    pub fn fit(&self, varying: &[&[f64]], target: &[f64]) -> Option<(Vec<f64>, f64)> {
+        self.solve(varying, target, true)
+    }
+
+    /// Coefficients only (no residual), for `output − model` gathered on the rows from the
+    /// two series (`model` at least as long as the last row).
+    pub fn coefficients_for(&self, varying: &[&[f64]], output: &[f64], model: &[f64]) -> Option<Vec<f64>> {
+        let t = self.rows.iter().map(|&i| Some(output.get(i)? - model.get(i)?)).collect::<Option<Vec<f64>>>()?;
+        self.solve_on_rows(varying, t, false).map(|(c, _)| c)
+    }
+
+    /// Coefficients and the mean squared residual for `output − model` on the rows.
+    pub fn fit_for(&self, varying: &[&[f64]], output: &[f64], model: &[f64]) -> Option<(Vec<f64>, f64)> {
+        let t = self.rows.iter().map(|&i| Some(output.get(i)? - model.get(i)?)).collect::<Option<Vec<f64>>>()?;
+        self.solve_on_rows(varying, t, true)
+    }
+}
+
+/// Least squares of `target` on `columns` over `rows`: coefficients and the mean squared
+/// residual on the rows (every column given, nothing prepared).
+pub fn lsq(columns: &[&[f64]], target: &[f64], rows: &[usize]) -> Option<(Vec<f64>, f64)> {
+    let none: Vec<Option<&[f64]>> = vec![None; columns.len()];
+    Projection::new(&none, rows).fit(columns, target)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn columns(n: usize, seed: u64) -> Vec<Vec<f64>> {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        (0..4).map(|_| (0..n).map(|_| rng.random_range(-1.0..1.0)).collect()).collect()
+    }
+
+    #[test]
+    fn prepared_columns_solve_bit_for_bit_as_from_scratch() {
+        let n = 301;
+        let cols = columns(n, 7);
+        let y: Vec<f64> = (0..n).map(|i| (i as f64 * 0.1).sin() + 0.3 * cols[1][i]).collect();
+        let rows: Vec<usize> = (0..n).filter(|i| i % 7 != 3).collect();
+        let refs: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
+        let scratch = lsq(&refs, &y, &rows).expect("solves");
+        // Columns 0 and 2 prepared, 1 and 3 given at the solve.
+        let prep = Projection::new(&[Some(refs[0]), None, Some(refs[2]), None], &rows);
+        let (c, mse) = prep.fit(&[refs[1], refs[3]], &y).expect("solves");
+        assert_eq!(c, scratch.0);
+        assert_eq!(mse.to_bits(), scratch.1.to_bits());
+        let m: Vec<f64> = (0..n).map(|i| 0.5 * y[i]).collect();
+        let half: Vec<f64> = y.iter().zip(&m).map(|(y, m)| y - m).collect();
+        let direct = prep.fit(&[refs[1], refs[3]], &half).expect("solves");
+        assert_eq!(prep.fit_for(&[refs[1], refs[3]], &y, &m), Some(direct.clone()));
+        assert_eq!(prep.coefficients_for(&[refs[1], refs[3]], &y, &m), Some(direct.0));
+        assert!((c[1] - 0.3).abs() < 0.05, "{c:?}");
+    }
+
+    #[test]
+    fn a_missing_column_or_short_model_is_no_solution() {
+        let cols = columns(50, 8);
+        let rows: Vec<usize> = (0..50).collect();
+        let prep = Projection::new(&[Some(&cols[0]), None], &rows);
+        assert!(prep.fit(&[], &cols[1]).is_none());
+        assert!(prep.coefficients_for(&[&cols[2]], &cols[1], &cols[3][..20]).is_none());
+        assert!(lsq(&[], &cols[1], &rows).is_some_and(|(c, mse)| c.is_empty() && mse > 0.0));
+    }
+}
