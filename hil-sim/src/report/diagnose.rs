@@ -225,10 +225,11 @@ fn outcome(c: &Tested) -> String {
         (None, false) if c.named_before => format!("not kept: read as {}, named in an earlier round", c.effect),
         (None, false) => match c.zero_phase.filter(|z| !z.passed) {
             Some(z) => format!(
-                "not kept: no better than the input smoothed without a lag's phase (τ = {:.3} ms; t = {:.1}, gain {:.1} %)",
+                "not kept: no better than the input smoothed without a lag's phase (τ = {:.3} ms): held-out RMSE {:.1} % {} than it, {:.0} % lower needed",
                 1e3 * z.tau_s,
-                z.test.t,
-                100.0 * z.test.gain
+                100.0 * z.test.gain.abs(),
+                if z.test.gain < 0.0 { "higher" } else { "lower" },
+                100.0 * crate::ident::diagnose::significance::MIN_GAIN
             ),
             None => String::new(),
         },
@@ -368,7 +369,7 @@ mod tests {
         });
         assert_eq!(
             outcome(&c),
-            "not kept: no better than the input smoothed without a lag's phase (τ = 2.100 ms; t = 1.2, gain 1.2 %)"
+            "not kept: no better than the input smoothed without a lag's phase (τ = 2.100 ms): held-out RMSE 1.2 % lower than it, 3 % lower needed"
         );
         c.zero_phase = None;
         c.named_before = true;

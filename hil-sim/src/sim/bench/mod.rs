@@ -185,6 +185,10 @@ pub enum Set {
     /// lag must beat the input smoothed without its phase).
     Fresh48,
     Fresh49,
+    /// The fifty-first and fifty-second, first run for the same report as fresh48 and fresh49,
+    /// with the same method.
+    Fresh50,
+    Fresh51,
 }
 
 impl Set {
@@ -242,6 +246,8 @@ impl Set {
         ("fresh47", Set::Fresh47, 614_000_000, 233),
         ("fresh48", Set::Fresh48, 640_000_000, 239),
         ("fresh49", Set::Fresh49, 666_000_000, 241),
+        ("fresh50", Set::Fresh50, 692_000_000, 251),
+        ("fresh51", Set::Fresh51, 718_000_000, 257),
     ];
 
     /// The seed of case `k` of this set.
