@@ -231,6 +231,9 @@ fn outcome(c: &Tested) -> String {
                 if z.test.gain < 0.0 { "higher" } else { "lower" },
                 100.0 * crate::ident::diagnose::significance::MIN_GAIN
             ),
+            None if c.barred => {
+                "not kept: another field lag of the round was no better than the input smoothed without its phase".into()
+            }
             None => String::new(),
         },
     }
@@ -358,6 +361,7 @@ mod tests {
             lag_or_delay: None,
             acting: None,
             zero_phase: None,
+            barred: false,
         };
         assert_eq!(outcome(&c), "not possible: a loop narrowing as the input grows (delta = -1.2)");
         c.impossible = None;
@@ -372,6 +376,12 @@ mod tests {
             "not kept: no better than the input smoothed without a lag's phase (τ = 2.100 ms): held-out RMSE 1.2 % lower than it, 3 % lower needed"
         );
         c.zero_phase = None;
+        c.barred = true;
+        assert_eq!(
+            outcome(&c),
+            "not kept: another field lag of the round was no better than the input smoothed without its phase"
+        );
+        c.barred = false;
         c.named_before = true;
         c.effect = "saturation".into();
         assert_eq!(outcome(&c), "not kept: read as saturation, named in an earlier round");

@@ -120,6 +120,7 @@ impl Judge<'_> {
                 lag_or_delay: None,
                 acting: None,
                 zero_phase: None,
+                barred: false,
             });
             let quiet = fits && tail_share < acting::QUIET_TAIL;
             let significant = test.significant;
@@ -152,8 +153,11 @@ impl Judge<'_> {
             if tested[k].zero_phase.is_none_or(|c| c.passed) {
                 break best;
             }
-            for (b, j) in barred.iter_mut().zip(&judged) {
-                *b |= j.reading.effect == "field_lag";
+            for (i, (b, j)) in barred.iter_mut().zip(&judged).enumerate() {
+                if j.reading.effect == "field_lag" {
+                    *b = true;
+                    tested[i].barred = i != k;
+                }
             }
         };
         let accepted = best.map(|k| {

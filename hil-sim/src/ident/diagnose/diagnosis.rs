@@ -103,6 +103,10 @@ pub struct Tested {
     /// ([`super::zero_phase`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub zero_phase: Option<super::zero_phase::Control>,
+    /// Another field lag of the round was no better than its zero-phase control, and every
+    /// field lag of the round was left out with it.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub barred: bool,
 }
 
 /// The whole diagnosis.
