@@ -286,10 +286,17 @@ mod tests {
         assert!(notes.iter().any(|n| n.contains("play operators")), "{notes:?}");
     }
 
+    /// A 12 ms lag of the field on that loop is named. A 6 ms one (the test's lag until the
+    /// sixteenth report) is no longer: on the play base its refit predicts the tail 2.9 %
+    /// better than the input smoothed without its phase, under the 3 % the zero-phase control
+    /// asks (`super::super::zero_phase`; the plays' own lag takes up most of its phase at
+    /// 1–10 Hz), and it is left out, not named as another effect.
     #[test]
     fn on_that_loop_a_field_lag_is_still_named() {
-        let (found, notes) = effects(&play_clutch(0.006, 6));
+        let (found, notes) = effects(&play_clutch(0.012, 6));
         assert_eq!(found.first().map(String::as_str), Some("field_lag"), "{found:?} {notes:?}");
+        let (found, notes) = effects(&play_clutch(0.006, 6));
+        assert!(found.iter().all(|e| e == "field_lag"), "{found:?} {notes:?}");
     }
 
     #[test]
