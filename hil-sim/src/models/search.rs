@@ -95,6 +95,21 @@ impl ParamSpec {
         }
     }
 
+    /// `v` if it lies in the box; otherwise just inside the nearer end (a millionth of the
+    /// box in: at the end itself a bounded search's unit map has zero slope and cannot move
+    /// it). A fit made in a wider box (a parameter held later) starts its refits from here.
+    pub fn into_box(&self, v: f64) -> f64 {
+        if self.fixed || (v >= self.lo && v <= self.hi) || !v.is_finite() {
+            return v;
+        }
+        let step = 1e-6 * (self.hi - self.lo);
+        if v < self.lo {
+            (self.lo + step).min(self.hi)
+        } else {
+            (self.hi - step).max(self.lo)
+        }
+    }
+
     /// Position of `v` in the box, 0 at `lo` and 1 at `hi` (clamped).
     pub fn to_unit(&self, v: f64) -> f64 {
         let s = match self.spacing {
@@ -253,4 +268,24 @@ pub fn network_layout(names: &[&'static str], n_params: usize) -> Vec<ParamSpec>
 /// decimal that reads back to the same f32 (46.9, not 46.900001525878906).
 pub fn published(v: f32) -> f64 {
     v.to_string().parse().unwrap_or(f64::from(v))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A value outside the box starts just inside its nearer end, where a bounded search can
+    /// move it; inside, fixed or not finite, it is left as it is.
+    #[test]
+    fn a_value_outside_the_box_starts_just_inside_it() {
+        let p = ParamSpec::new("alpha", 0.0, 100.0, 1.0);
+        assert_eq!(p.into_box(-22.1), 1e-4);
+        assert_eq!(p.into_box(250.0), 100.0 - 1e-4);
+        assert_eq!(p.into_box(3.0), 3.0);
+        assert_eq!(p.into_box(0.0), 0.0);
+        assert!(p.into_box(f64::NAN).is_nan());
+        assert_eq!(ParamSpec::new("n", 1.0, 3.0, 2.0).fixed(5.0).into_box(5.0), 5.0);
+        // Where the unit map's slope is zero (the box's end) the value is not put.
+        assert!(p.to_unit(p.into_box(-1.0)) > 0.0);
+    }
 }

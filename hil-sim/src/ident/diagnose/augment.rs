@@ -468,7 +468,10 @@ impl<'a> Problem<'a> {
     ) -> Option<(Fitted, f64)> {
         let aug = AugSim { prob: self, transforms, terms, tune, cache: std::sync::Mutex::new(Vec::new()) };
         let mut spec = self.spec.clone();
-        let mut start = theta.to_vec();
+        // A fitted value outside the refits' box (a parameter held ≥ 0 after the fit) starts
+        // inside it: from outside, the box's end would stick and the start win unchanged.
+        let mut start: Vec<f64> =
+            theta.iter().enumerate().map(|(j, v)| spec.params.get(j).map_or(*v, |p| p.into_box(*v))).collect();
         if let Some(t) = tune {
             let (lo, hi) = (t.lo.min(t.hi), t.hi.max(t.lo));
             spec.params.push(crate::models::search::ParamSpec {

@@ -189,6 +189,10 @@ pub enum Set {
     /// with the same method.
     Fresh50,
     Fresh51,
+    /// The fifty-third and fifty-fourth, first run for the seventeenth report (the algebraic
+    /// base's α held ≥ 0 from the refits' start, not only in their box).
+    Fresh52,
+    Fresh53,
 }
 
 impl Set {
@@ -248,6 +252,8 @@ impl Set {
         ("fresh49", Set::Fresh49, 666_000_000, 241),
         ("fresh50", Set::Fresh50, 692_000_000, 251),
         ("fresh51", Set::Fresh51, 718_000_000, 257),
+        ("fresh52", Set::Fresh52, 744_000_000, 263),
+        ("fresh53", Set::Fresh53, 772_000_000, 269),
     ];
 
     /// The seed of case `k` of this set.
