@@ -99,7 +99,7 @@ impl ParamSpec {
     /// box in: at the end itself a bounded search's unit map has zero slope and cannot move
     /// it). A fit made in a wider box (a parameter held later) starts its refits from here.
     pub fn into_box(&self, v: f64) -> f64 {
-        if self.fixed || (v >= self.lo && v <= self.hi) || !v.is_finite() {
+        if self.fixed || (self.lo..=self.hi).contains(&v) || !v.is_finite() {
             return v;
         }
         let step = 1e-6 * (self.hi - self.lo);
