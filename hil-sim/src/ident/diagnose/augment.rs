@@ -109,6 +109,8 @@ pub enum InputMap {
     Play { radius: f64 },
     /// `x_ref·sgn(x)·|x/x_ref|^p`, [`super::level_map`].
     LevelPower { x_ref: f64, p: f64 },
+    /// `x³/x_ref²`, an odd cubic of the input ([`super::contenders::plays`]).
+    Cube { x_ref: f64 },
 }
 
 impl InputMap {
@@ -117,6 +119,7 @@ impl InputMap {
         match *self {
             Self::Play { radius } => play(x, radius),
             Self::LevelPower { x_ref, p } => x.iter().map(|v| x_ref * v.signum() * (v.abs() / x_ref).powf(p)).collect(),
+            Self::Cube { x_ref } => x.iter().map(|v| v * (v / x_ref).powi(2)).collect(),
         }
     }
 
@@ -127,7 +130,7 @@ impl InputMap {
     /// exponent fitted 1.8–2.0 for 1.4, then "saturated" back: 2 false alarms).
     pub fn follows(&self, t: &Transform) -> bool {
         match self {
-            Self::Play { .. } => true,
+            Self::Play { .. } | Self::Cube { .. } => true,
             Self::LevelPower { .. } => {
                 matches!(
                     t,
@@ -179,6 +182,10 @@ impl Term {
     }
     pub fn output_saturation(name: impl Into<String>, t_sat: f64) -> Self {
         Self { name: name.into(), values: Vec::new(), kind: TermKind::OutputSaturation { t_sat }, of_input: None }
+    }
+    /// Whether its column is its values, the same whatever the base model predicts.
+    pub fn is_additive(&self) -> bool {
+        matches!(self.kind, TermKind::Additive)
     }
     fn column(&self, m: &[f64]) -> std::borrow::Cow<'_, [f64]> {
         use std::borrow::Cow;
@@ -421,8 +428,7 @@ impl<'a> Problem<'a> {
 
     /// The least squares of `terms` on the training rows, their additive columns prepared.
     fn projection(&self, terms: &[Term]) -> Projection {
-        let fixed: Vec<Option<&[f64]>> =
-            terms.iter().map(|t| matches!(t.kind, TermKind::Additive).then_some(t.values.as_slice())).collect();
+        let fixed: Vec<Option<&[f64]>> = terms.iter().map(|t| t.is_additive().then_some(t.values.as_slice())).collect();
         Projection::new(&fixed, &self.train)
     }
 
@@ -438,7 +444,7 @@ impl<'a> Problem<'a> {
     ) -> Option<(Vec<f64>, Vec<f64>, f64)> {
         let cols: Vec<std::borrow::Cow<'_, [f64]>> = terms.iter().map(|t| t.column(m)).collect();
         let varying: Vec<&[f64]> =
-            terms.iter().zip(&cols).filter(|(t, _)| !matches!(t.kind, TermKind::Additive)).map(|(_, c)| &**c).collect();
+            terms.iter().zip(&cols).filter(|(t, _)| !t.is_additive()).map(|(_, c)| &**c).collect();
         let (beta, mse) = if with_mse {
             projection.fit_for(&varying, &self.data.output, m)?
         } else {

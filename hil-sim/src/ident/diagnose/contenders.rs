@@ -35,14 +35,23 @@ const BASE_ITERATIONS: usize = 8;
 /// Rate-independent hysteresis as terms linear in their weights (a Prandtl–Ishlinskii sum of
 /// play operators of the input `x`, radii [`PLAY_RADII`] × its span): a loop that no seed
 /// model's family has and that no catalog effect is (its width does not grow with the rate,
-/// the level or the temperature).
+/// the level or the temperature). With them an odd cubic of the input (`x³/max|x|²`), so
+/// that the host's static curve (`k·x + α·|x|·x³`, α ≥ 0) can curve both ways on a bipolar
+/// field: without it (until 2026-11-29) a play truth's `b + b³` curve was met by whatever
+/// bent the host's (an offset of the field, a saturating map) and named on play nulls
+/// (fresh52's `770306049`: `sensor_offset`).
 pub fn plays(x: &[f64]) -> Vec<Term> {
     let (lo, hi) = crate::numerics::stats::min_max(x);
     let span = if hi > lo { hi - lo } else { 0.0 };
-    PLAY_RADII
+    let mut terms: Vec<Term> = PLAY_RADII
         .iter()
         .map(|f| Term::of_input(format!("play_{:.0}pct", 100.0 * f), InputMap::Play { radius: f * span }, x))
-        .collect()
+        .collect();
+    let x_ref = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if x_ref > 0.0 && x_ref.is_finite() {
+        terms.push(Term::of_input("cubic", InputMap::Cube { x_ref }, x));
+    }
+    terms
 }
 
 /// One contender after its first round.
@@ -187,7 +196,8 @@ fn play_note(id: &str, input: &str) -> String {
     let radii: Vec<String> = PLAY_RADII.iter().map(|f| format!("{:.0}", 100.0 * f)).collect();
     format!(
         "the base model {id} was given rate-independent hysteresis (play operators of radii {} % of the {input} \
-         span): no seed model has that loop, and every candidate was judged on top of it",
+         span) and an odd cubic of the {input}: no seed model has that loop, and every candidate was judged on top \
+         of it",
         radii.join(", ")
     )
 }
@@ -244,8 +254,12 @@ mod tests {
         let p = play(&[0.0, 1.0, 2.0, 1.5, 1.0, 0.0], 0.5);
         assert_eq!(p, vec![0.0, 0.5, 1.5, 1.5, 1.5, 0.5]);
         let flat = plays(&[0.3; 50]);
-        assert_eq!(flat.len(), PLAY_RADII.len());
+        assert_eq!(flat.len(), PLAY_RADII.len() + 1);
         assert!(flat.iter().all(|t| t.values.iter().all(|v| *v == 0.3)));
+        // The cubic is odd and as large as the input where the input is largest.
+        let cubic = plays(&[-0.5, 0.25, 0.5, 0.0]).pop().map(|t| t.values);
+        assert_eq!(cubic, Some(vec![-0.5, 0.0625, 0.5, 0.0]));
+        assert_eq!(plays(&[0.0; 9]).len(), PLAY_RADII.len(), "no cubic of a zero input");
     }
 
     /// 12 s at 1 kHz of a clutch whose loop is rate-independent (three play operators of

@@ -14,7 +14,7 @@
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
 
-use super::augment::{Fitted, Problem, Term, TermKind};
+use super::augment::{Fitted, Problem, Term};
 use super::candidates::Candidate;
 use crate::ident::fit::separable::{affine_columns, set_clamped, Grid};
 use crate::numerics::lstsq;
@@ -51,8 +51,7 @@ pub fn starts(prob: &Problem<'_>, cands: &[Candidate], reference: &Fitted, used:
 fn best_points(prob: &Problem<'_>, reference: &Fitted, pieces: &[Option<Vec<Term>>]) -> Vec<Solved> {
     let none = vec![None; pieces.len()];
     let affine = crate::models::host(prob.spec.id).map_or(&[][..], |h| h.affine);
-    let additive = |t: &Term| matches!(t.kind, TermKind::Additive);
-    if affine.is_empty() || !reference.terms.iter().all(additive) {
+    if affine.is_empty() || !reference.terms.iter().all(Term::is_additive) {
         return none;
     }
     let n_model = prob.sim.n_params();
@@ -64,7 +63,7 @@ fn best_points(prob: &Problem<'_>, reference: &Fitted, pieces: &[Option<Vec<Term
     let mut columns: Vec<Vec<f64>> = Vec::new();
     let mut of_piece: Vec<Option<Vec<usize>>> = Vec::with_capacity(pieces.len());
     for terms in pieces {
-        let terms = terms.as_ref().filter(|t| !t.is_empty() && t.iter().all(additive));
+        let terms = terms.as_ref().filter(|t| !t.is_empty() && t.iter().all(Term::is_additive));
         of_piece.push(terms.map(|terms| {
             let at = columns.len();
             let terms = prob.through(terms.clone(), &reference.transforms, &x);

@@ -18,34 +18,61 @@ struct Scaled {
 }
 
 impl Scaled {
-    fn new(column: &[f64], rows: &[usize]) -> Self {
-        let v: Vec<f64> = rows.iter().map(|&i| column[i]).collect();
+    /// `None` when the column is shorter than the last row.
+    fn new(column: &[f64], rows: &[usize]) -> Option<Self> {
+        let v = gather(column, rows)?;
         let s = dot(&v, &v).sqrt();
         let norm = if s > 0.0 && s.is_finite() { s } else { 1.0 };
-        Self { values: v.into_iter().map(|x| x / norm).collect(), norm }
+        Some(Self { values: v.into_iter().map(|x| x / norm).collect(), norm })
     }
+}
+
+/// `values` on `rows`; `None` when a row is past its end.
+fn gather(values: &[f64], rows: &[usize]) -> Option<Vec<f64>> {
+    rows.iter().map(|&i| values.get(i).copied()).collect()
+}
+
+/// `output − model` on `rows`; `None` when a row is past the end of either.
+fn difference(output: &[f64], model: &[f64], rows: &[usize]) -> Option<Vec<f64>> {
+    rows.iter().map(|&i| Some(output.get(i)? - model.get(i)?)).collect()
+}
+
+/// A column of a [`Projection`].
+enum Fixed {
+    /// The same at every solve: gathered and scaled once.
+    Prepared(Scaled),
+    /// The same at every solve but shorter than the last row: no solve.
+    Short,
+    /// Given at every solve.
+    Given,
 }
 
 /// Least squares on fixed rows whose fixed columns are prepared once.
 pub struct Projection {
     rows: Vec<usize>,
-    /// One entry per column: `Some` for a fixed column (gathered and scaled), `None` for
-    /// one given at every solve.
-    fixed: Vec<Option<Scaled>>,
+    /// One entry per column.
+    fixed: Vec<Fixed>,
     /// Products of the fixed columns' pairs (row-major, `k × k`; `None` where either varies).
     products: Vec<Option<f64>>,
 }
 
 impl Projection {
     /// `columns`: `Some(values)` for a column that stays the same across solves (indexed by
-    /// row, like the target), `None` for one given to every solve.
+    /// row, like the target), `None` for one given to every solve. A fixed column shorter
+    /// than the last row is kept as missing: every solve then fails.
     pub fn new(columns: &[Option<&[f64]>], rows: &[usize]) -> Self {
-        let fixed: Vec<Option<Scaled>> = columns.iter().map(|c| c.map(|c| Scaled::new(c, rows))).collect();
+        let fixed: Vec<Fixed> = columns
+            .iter()
+            .map(|c| match c {
+                Some(c) => Scaled::new(c, rows).map_or(Fixed::Short, Fixed::Prepared),
+                None => Fixed::Given,
+            })
+            .collect();
         let k = fixed.len();
         let mut products = vec![None; k * k];
         for a in 0..k {
             for b in a..k {
-                if let (Some(x), Some(y)) = (&fixed[a], &fixed[b]) {
+                if let (Fixed::Prepared(x), Fixed::Prepared(y)) = (&fixed[a], &fixed[b]) {
                     products[a * k + b] = Some(dot(&x.values, &y.values));
                 }
             }
@@ -53,15 +80,9 @@ impl Projection {
         Self { rows: rows.to_vec(), fixed, products }
     }
 
-    /// Coefficients of the columns for `target` (indexed by row) and the scaled solution's
-    /// residual on the rows when `with_mse`. `varying`: the columns prepared as `None`, in
-    /// their order. `None` when a column is missing or the solve fails.
-    fn solve(&self, varying: &[&[f64]], target: &[f64], with_mse: bool) -> Option<(Vec<f64>, f64)> {
-        let t: Vec<f64> = self.rows.iter().map(|&i| target[i]).collect();
-        self.solve_on_rows(varying, t, with_mse)
-    }
-
-    /// As [`Projection::solve`], the target already gathered on the rows.
+    /// Coefficients of the columns for the target `t` gathered on the rows, and the scaled
+    /// solution's residual on the rows when `with_mse`. `varying`: the columns prepared as
+    /// `None`, in their order. `None` when a column is missing or short, or the solve fails.
     fn solve_on_rows(&self, varying: &[&[f64]], t: Vec<f64>, with_mse: bool) -> Option<(Vec<f64>, f64)> {
         let n = self.rows.len().max(1) as f64;
         let k = self.fixed.len();
@@ -73,11 +94,20 @@ impl Projection {
             .fixed
             .iter()
             .map(|f| match f {
-                Some(_) => Some(None),
-                None => given.next().map(|c| Some(Scaled::new(c, &self.rows))),
+                Fixed::Prepared(_) => Some(None),
+                Fixed::Short => None,
+                Fixed::Given => given.next().and_then(|c| Scaled::new(c, &self.rows)).map(Some),
             })
             .collect::<Option<_>>()?;
-        let cols: Vec<&Scaled> = self.fixed.iter().zip(&made).filter_map(|(f, m)| f.as_ref().or(m.as_ref())).collect();
+        let cols: Vec<&Scaled> = self
+            .fixed
+            .iter()
+            .zip(&made)
+            .filter_map(|(f, m)| match f {
+                Fixed::Prepared(s) => Some(s),
+                _ => m.as_ref(),
+            })
+            .collect();
         // The normal equations from column products (prepared where both are fixed), ridged.
         let mut g = nalgebra::DMatrix::<f64>::zeros(k, k);
         for a in 0..k {
@@ -110,20 +140,18 @@ impl Projection {
 
     /// Coefficients and the mean squared residual on the rows.
     pub fn fit(&self, varying: &[&[f64]], target: &[f64]) -> Option<(Vec<f64>, f64)> {
-        self.solve(varying, target, true)
+        self.solve_on_rows(varying, gather(target, &self.rows)?, true)
     }
 
     /// Coefficients only (no residual), for `output − model` gathered on the rows from the
     /// two series (`model` at least as long as the last row).
     pub fn coefficients_for(&self, varying: &[&[f64]], output: &[f64], model: &[f64]) -> Option<Vec<f64>> {
-        let t = self.rows.iter().map(|&i| Some(output.get(i)? - model.get(i)?)).collect::<Option<Vec<f64>>>()?;
-        self.solve_on_rows(varying, t, false).map(|(c, _)| c)
+        self.solve_on_rows(varying, difference(output, model, &self.rows)?, false).map(|(c, _)| c)
     }
 
     /// Coefficients and the mean squared residual for `output − model` on the rows.
     pub fn fit_for(&self, varying: &[&[f64]], output: &[f64], model: &[f64]) -> Option<(Vec<f64>, f64)> {
-        let t = self.rows.iter().map(|&i| Some(output.get(i)? - model.get(i)?)).collect::<Option<Vec<f64>>>()?;
-        self.solve_on_rows(varying, t, true)
+        self.solve_on_rows(varying, difference(output, model, &self.rows)?, true)
     }
 }
 
@@ -173,5 +201,9 @@ mod tests {
         assert!(prep.fit(&[], &cols[1]).is_none());
         assert!(prep.coefficients_for(&[&cols[2]], &cols[1], &cols[3][..20]).is_none());
         assert!(lsq(&[], &cols[1], &rows).is_some_and(|(c, mse)| c.is_empty() && mse > 0.0));
+        // A column or a target shorter than the last row is no solution, never a panic.
+        assert!(Projection::new(&[Some(&cols[0][..20])], &rows).fit(&[], &cols[1]).is_none());
+        assert!(lsq(&[&cols[0][..20]], &cols[1], &rows).is_none());
+        assert!(lsq(&[&cols[0]], &cols[1][..20], &rows).is_none());
     }
 }

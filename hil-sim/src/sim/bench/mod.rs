@@ -193,6 +193,10 @@ pub enum Set {
     /// base's α held ≥ 0 from the refits' start, not only in their box).
     Fresh52,
     Fresh53,
+    /// The fifty-fifth and fifty-sixth, first run for the eighteenth report (the play host's
+    /// odd cubic).
+    Fresh54,
+    Fresh55,
 }
 
 impl Set {
@@ -254,6 +258,8 @@ impl Set {
         ("fresh51", Set::Fresh51, 718_000_000, 257),
         ("fresh52", Set::Fresh52, 744_000_000, 263),
         ("fresh53", Set::Fresh53, 772_000_000, 269),
+        ("fresh54", Set::Fresh54, 802_000_000, 271),
+        ("fresh55", Set::Fresh55, 832_000_000, 277),
     ];
 
     /// The seed of case `k` of this set.
