@@ -105,11 +105,12 @@ pub struct Term {
 /// well, and the plays see a saturated or offset field too.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum InputMap {
-    /// A play operator of radius `radius` (input units), [`play`].
+    /// A play operator of radius `radius` (input units), [`super::contenders::play`].
     Play { radius: f64 },
     /// `x_ref·sgn(x)·|x/x_ref|^p`, [`super::level_map`].
     LevelPower { x_ref: f64, p: f64 },
-    /// `x³/x_ref²`, an odd cubic of the input ([`super::contenders::plays`]).
+    /// `x³/x_ref²`, an odd cubic of the input ([`super::contenders::plays`]); its weight is
+    /// held ≥ 0 ([`Term::at_least_zero`]).
     Cube { x_ref: f64 },
 }
 
@@ -117,7 +118,7 @@ impl InputMap {
     /// The term's values for the input `x`.
     pub fn values(&self, x: &[f64]) -> Vec<f64> {
         match *self {
-            Self::Play { radius } => play(x, radius),
+            Self::Play { radius } => super::contenders::play(x, radius),
             Self::LevelPower { x_ref, p } => x.iter().map(|v| x_ref * v.signum() * (v.abs() / x_ref).powf(p)).collect(),
             Self::Cube { x_ref } => x.iter().map(|v| v * (v / x_ref).powi(2)).collect(),
         }
@@ -139,18 +140,6 @@ impl InputMap {
             }
         }
     }
-}
-
-/// A play operator (backlash) of radius `r`: its output follows `x` within `±r`, starting
-/// at `x[0]`.
-pub fn play(x: &[f64], r: f64) -> Vec<f64> {
-    let mut s = x.first().copied().unwrap_or(0.0);
-    x.iter()
-        .map(|v| {
-            s = s.max(v - r).min(v + r);
-            s
-        })
-        .collect()
 }
 
 /// How a term's column is made from its values and the base model's output `m`.
@@ -186,6 +175,11 @@ impl Term {
     /// Whether its column is its values, the same whatever the base model predicts.
     pub fn is_additive(&self) -> bool {
         matches!(self.kind, TermKind::Additive)
+    }
+    /// Whether its weight is held ≥ 0: the cubic of the input, which would otherwise bend
+    /// the base's curve over and take up a saturation.
+    pub fn at_least_zero(&self) -> bool {
+        matches!(self.of_input, Some((InputMap::Cube { .. }, _)))
     }
     fn column(&self, m: &[f64]) -> std::borrow::Cow<'_, [f64]> {
         use std::borrow::Cow;
@@ -429,7 +423,7 @@ impl<'a> Problem<'a> {
     /// The least squares of `terms` on the training rows, their additive columns prepared.
     fn projection(&self, terms: &[Term]) -> Projection {
         let fixed: Vec<Option<&[f64]>> = terms.iter().map(|t| t.is_additive().then_some(t.values.as_slice())).collect();
-        Projection::new(&fixed, &self.train)
+        Projection::new(&fixed, &self.train).at_least_zero(terms.iter().map(Term::at_least_zero).collect())
     }
 
     /// β for fixed θ (model output `m`): least squares of `y − m` on the terms' columns
@@ -539,6 +533,7 @@ impl<'a> Problem<'a> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::contenders::play;
     use super::*;
 
     #[test]

@@ -35,9 +35,9 @@ const BASE_ITERATIONS: usize = 8;
 /// Rate-independent hysteresis as terms linear in their weights (a Prandtl–Ishlinskii sum of
 /// play operators of the input `x`, radii [`PLAY_RADII`] × its span): a loop that no seed
 /// model's family has and that no catalog effect is (its width does not grow with the rate,
-/// the level or the temperature). With them an odd cubic of the input (`x³/max|x|²`), so
-/// that the host's static curve (`k·x + α·|x|·x³`, α ≥ 0) can curve both ways on a bipolar
-/// field: without it (until 2026-11-29) a play truth's `b + b³` curve was met by whatever
+/// the level or the temperature). With them an odd cubic of the input (`x³/max|x|²`, its
+/// weight ≥ 0, as the host's α), so that the host's static curve (`k·x + α·|x|·x³`) grows
+/// faster than linearly on both sides of a bipolar field without bending over: without it (until 2026-11-29) a play truth's `b + b³` curve was met by whatever
 /// bent the host's (an offset of the field, a saturating map) and named on play nulls
 /// (fresh52's `770306049`: `sensor_offset`).
 pub fn plays(x: &[f64]) -> Vec<Term> {
@@ -52,6 +52,18 @@ pub fn plays(x: &[f64]) -> Vec<Term> {
         terms.push(Term::of_input("cubic", InputMap::Cube { x_ref }, x));
     }
     terms
+}
+
+/// A play operator (backlash) of radius `r`: its output follows `x` within `±r`, starting
+/// at `x[0]`.
+pub fn play(x: &[f64], r: f64) -> Vec<f64> {
+    let mut s = x.first().copied().unwrap_or(0.0);
+    x.iter()
+        .map(|v| {
+            s = s.max(v - r).min(v + r);
+            s
+        })
+        .collect()
 }
 
 /// One contender after its first round.
@@ -196,7 +208,7 @@ fn play_note(id: &str, input: &str) -> String {
     let radii: Vec<String> = PLAY_RADII.iter().map(|f| format!("{:.0}", 100.0 * f)).collect();
     format!(
         "the base model {id} was given rate-independent hysteresis (play operators of radii {} % of the {input} \
-         span) and an odd cubic of the {input}: no seed model has that loop, and every candidate was judged on top \
+         span) and an odd cubic of {input}: no seed model has that loop, and every candidate was judged on top \
          of it",
         radii.join(", ")
     )
@@ -244,7 +256,6 @@ fn note(openings: &[Opening<'_>], chosen: usize, judge: &Judge<'_>) -> Option<St
 
 #[cfg(test)]
 mod tests {
-    use super::super::augment::play;
     use super::*;
     use crate::ident::diagnose::{diagnose, DiagnoseOptions};
     use rand::SeedableRng;

@@ -54,6 +54,8 @@ pub struct Projection {
     fixed: Vec<Fixed>,
     /// Products of the fixed columns' pairs (row-major, `k × k`; `None` where either varies).
     products: Vec<Option<f64>>,
+    /// The columns whose coefficient is held ≥ 0 ([`Projection::at_least_zero`]).
+    at_least_zero: Vec<bool>,
 }
 
 impl Projection {
@@ -77,7 +79,14 @@ impl Projection {
                 }
             }
         }
-        Self { rows: rows.to_vec(), fixed, products }
+        Self { rows: rows.to_vec(), fixed, products, at_least_zero: Vec::new() }
+    }
+
+    /// The same, with the coefficients of the columns marked `true` held ≥ 0: a column whose
+    /// coefficient comes out negative is left out and the rest solved again (until none
+    /// is), so that its coefficient is 0.
+    pub fn at_least_zero(self, marked: Vec<bool>) -> Self {
+        Self { at_least_zero: marked, ..self }
     }
 
     /// Coefficients of the columns for the target `t` gathered on the rows, and the scaled
@@ -121,7 +130,7 @@ impl Projection {
             g[(a, a)] += 1e-10;
         }
         let rhs = nalgebra::DVector::<f64>::from_fn(k, |a, _| dot(&cols[a].values, &t));
-        let sol = lstsq::solve_cholesky(g, &rhs, 1e-12)?;
+        let sol = self.solve_held(g, rhs)?;
         let coef: Vec<f64> = sol.iter().zip(&cols).map(|(v, c)| v / c.norm).collect();
         if coef.iter().any(|v| !v.is_finite()) {
             return None;
@@ -136,6 +145,32 @@ impl Projection {
             }
         }
         Some((coef, dot(&r, &r) / n))
+    }
+
+    /// The ridged normal equations `g·s = rhs` solved, the coefficients held ≥ 0 left out
+    /// (row and column of `g` made the identity's, `rhs` 0) while one is negative.
+    fn solve_held(
+        &self,
+        mut g: nalgebra::DMatrix<f64>,
+        mut rhs: nalgebra::DVector<f64>,
+    ) -> Option<nalgebra::DVector<f64>> {
+        if !self.at_least_zero.contains(&true) {
+            return lstsq::solve_cholesky(g, &rhs, 1e-12);
+        }
+        loop {
+            let sol = lstsq::solve_cholesky(g.clone(), &rhs, 1e-12)?;
+            let negative: Vec<usize> =
+                (0..sol.len()).filter(|&a| sol[a] < 0.0 && self.at_least_zero.get(a) == Some(&true)).collect();
+            if negative.is_empty() {
+                return Some(sol);
+            }
+            for a in negative {
+                g.row_mut(a).fill(0.0);
+                g.column_mut(a).fill(0.0);
+                g[(a, a)] = 1.0;
+                rhs[a] = 0.0;
+            }
+        }
     }
 
     /// Coefficients and the mean squared residual on the rows.
@@ -191,6 +226,27 @@ mod tests {
         assert_eq!(prep.fit_for(&[refs[1], refs[3]], &y, &m), Some(direct.clone()));
         assert_eq!(prep.coefficients_for(&[refs[1], refs[3]], &y, &m), Some(direct.0));
         assert!((c[1] - 0.3).abs() < 0.05, "{c:?}");
+    }
+
+    #[test]
+    fn a_coefficient_held_at_least_zero_is_zero_where_it_would_be_negative() {
+        let n = 200;
+        let cols = columns(n, 9);
+        let rows: Vec<usize> = (0..n).collect();
+        let refs: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
+        let y: Vec<f64> = (0..n).map(|i| 0.7 * cols[0][i] - 0.4 * cols[1][i] + 0.2 * cols[2][i]).collect();
+        let free = lsq(&refs[..3], &y, &rows).expect("solves").0;
+        assert!(free[1] < -0.3, "{free:?}");
+        let held = Projection::new(&[Some(refs[0]), None, Some(refs[2])], &rows).at_least_zero(vec![false, true, true]);
+        let (c, mse) = held.fit(&[refs[1]], &y).expect("solves");
+        assert_eq!(c[1], 0.0);
+        // The others are the least squares without it.
+        let (without, mse_without) = lsq(&[refs[0], refs[2]], &y, &rows).expect("solves");
+        assert!((c[0] - without[0]).abs() < 1e-9 && (c[2] - without[1]).abs() < 1e-9, "{c:?} {without:?}");
+        assert!((mse - mse_without).abs() < 1e-12 && mse > 0.0);
+        // A positive coefficient held ≥ 0 is the free one.
+        let pos = Projection::new(&[Some(refs[0]), None, Some(refs[2])], &rows).at_least_zero(vec![true, false, true]);
+        assert_eq!(pos.fit(&[refs[1]], &y).expect("solves").0, free);
     }
 
     #[test]

@@ -193,10 +193,14 @@ pub enum Set {
     /// base's α held ≥ 0 from the refits' start, not only in their box).
     Fresh52,
     Fresh53,
-    /// The fifty-fifth and fifty-sixth, first run for the eighteenth report (the play host's
-    /// odd cubic).
+    /// The fifty-fifth and fifty-sixth, first run for a trial of the play host's odd cubic
+    /// with a free weight, stopped halfway (eighteenth report).
     Fresh54,
     Fresh55,
+    /// The fifty-seventh and fifty-eighth, first run for the eighteenth report (the play
+    /// host's odd cubic, its weight ≥ 0).
+    Fresh56,
+    Fresh57,
 }
 
 impl Set {
@@ -260,6 +264,8 @@ impl Set {
         ("fresh53", Set::Fresh53, 772_000_000, 269),
         ("fresh54", Set::Fresh54, 802_000_000, 271),
         ("fresh55", Set::Fresh55, 832_000_000, 277),
+        ("fresh56", Set::Fresh56, 862_000_000, 281),
+        ("fresh57", Set::Fresh57, 892_000_000, 283),
     ];
 
     /// The seed of case `k` of this set.
