@@ -254,6 +254,17 @@ fn a_saturation_under_plays_is_not_taken_up_by_a_bent_base() {
     each_right([(Set::Fresh48, 640_015_774), (Set::Fresh51, 718_004_626), (Set::Fresh51, 718_039_578)]);
 }
 
+/// On play truths the play host's static curve, `k·b + α·|b|·b³` with α ≥ 0, curved one way
+/// only on a bipolar field: a play null (fresh52 `770306049`, noise at 10 kHz) was named a
+/// −25 mT `sensor_offset`, which moved where it bent, a saturation under blocks at 10 kHz
+/// (fresh52 `744004734`) nothing, and a field lag under blocks (fresh53 `772038736`)
+/// `transport_delay` (development since their report). With an odd cubic of the field, its
+/// weight ≥ 0, beside the plays, each is named right.
+#[test]
+fn a_play_truths_curve_is_the_hosts_with_its_cubic() {
+    each_right([(Set::Fresh52, 770_306_049), (Set::Fresh52, 744_004_734), (Set::Fresh53, 772_038_736)]);
+}
+
 /// Four nulls (fresh21 `145701067`, fresh22 `156100606` and `156102424`, fresh26 `213301017`:
 /// development since their reports) on which a term gained 7–9 % of the held-out RMSE,
 /// significant on the blocks, and was named: a finding needs 10 %
