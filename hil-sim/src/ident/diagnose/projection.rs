@@ -84,7 +84,10 @@ impl Projection {
 
     /// The same, with the coefficients of the columns marked `true` held ≥ 0: a column whose
     /// coefficient comes out negative is left out and the rest solved again (until none
-    /// is), so that its coefficient is 0.
+    /// is), so that its coefficient is 0. Exact for one held column (the play host's cubic,
+    /// the only one today: a convex quadratic whose free minimum has it < 0 is least, over
+    /// it ≥ 0, at 0); with several it is not the active-set answer of
+    /// [`crate::numerics::nnls`], which a second held column should use instead.
     pub fn at_least_zero(self, marked: Vec<bool>) -> Self {
         Self { at_least_zero: marked, ..self }
     }
