@@ -105,7 +105,7 @@ pub struct Term {
 /// well, and the plays see a saturated or offset field too.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum InputMap {
-    /// A play operator of radius `radius` (input units), [`super::contenders::play`].
+    /// A play operator of radius `radius` (input units), [`super::play::play`].
     Play { radius: f64 },
     /// `x_ref·sgn(x)·|x/x_ref|^p`, [`super::level_map`].
     LevelPower { x_ref: f64, p: f64 },
@@ -118,7 +118,7 @@ impl InputMap {
     /// The term's values for the input `x`.
     pub fn values(&self, x: &[f64]) -> Vec<f64> {
         match *self {
-            Self::Play { radius } => super::contenders::play(x, radius),
+            Self::Play { radius } => super::play::play(x, radius),
             Self::LevelPower { x_ref, p } => x.iter().map(|v| x_ref * v.signum() * (v.abs() / x_ref).powf(p)).collect(),
             Self::Cube { x_ref } => x.iter().map(|v| v * (v / x_ref).powi(2)).collect(),
         }
@@ -533,7 +533,7 @@ impl<'a> Problem<'a> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::contenders::play;
+    use super::super::play::play;
     use super::*;
 
     #[test]

@@ -21,6 +21,7 @@ use super::base::{Base, Bases, PLAY_HOST};
 use super::candidates::Candidate;
 use super::locate::{self, Locate};
 use super::options::DiagnoseError;
+pub use super::play::play;
 use super::{level_map, rank, significance};
 use crate::ident::fit::Dataset;
 
@@ -52,18 +53,6 @@ pub fn plays(x: &[f64]) -> Vec<Term> {
         terms.push(Term::of_input("cubic", InputMap::Cube { x_ref }, x));
     }
     terms
-}
-
-/// A play operator (backlash) of radius `r`: its output follows `x` within `±r`, starting
-/// at `x[0]`.
-pub fn play(x: &[f64], r: f64) -> Vec<f64> {
-    let mut s = x.first().copied().unwrap_or(0.0);
-    x.iter()
-        .map(|v| {
-            s = s.max(v - r).min(v + r);
-            s
-        })
-        .collect()
 }
 
 /// One contender after its first round.
@@ -256,6 +245,7 @@ fn note(openings: &[Opening<'_>], chosen: usize, judge: &Judge<'_>) -> Option<St
 
 #[cfg(test)]
 mod tests {
+    use super::super::play::play;
     use super::*;
     use crate::ident::diagnose::{diagnose, DiagnoseOptions};
     use rand::SeedableRng;

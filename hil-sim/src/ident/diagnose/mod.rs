@@ -49,6 +49,7 @@ pub mod level_map;
 pub mod locate;
 pub mod options;
 pub mod physical;
+pub mod play;
 pub mod profile;
 pub mod projection;
 pub mod rank;
