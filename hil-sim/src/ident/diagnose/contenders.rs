@@ -21,7 +21,6 @@ use super::base::{Base, Bases, PLAY_HOST};
 use super::candidates::Candidate;
 use super::locate::{self, Locate};
 use super::options::DiagnoseError;
-pub use super::play::play;
 use super::{level_map, rank, significance};
 use crate::ident::fit::Dataset;
 
@@ -38,9 +37,9 @@ const BASE_ITERATIONS: usize = 8;
 /// model's family has and that no catalog effect is (its width does not grow with the rate,
 /// the level or the temperature). With them an odd cubic of the input (`x³/max|x|²`, its
 /// weight ≥ 0, as the host's α), so that the host's static curve (`k·x + α·|x|·x³`) grows
-/// faster than linearly on both sides of a bipolar field without bending over: without it (until 2026-11-29) a play truth's `b + b³` curve was met by whatever
-/// bent the host's (an offset of the field, a saturating map) and named on play nulls
-/// (fresh52's `770306049`: `sensor_offset`).
+/// faster than linearly on both sides of a bipolar field without bending over: without it
+/// (until 2026-11-29) a play truth's `b + b³` curve was met by whatever bent the host's (an
+/// offset of the field, a saturating map) and named on play nulls (fresh52's `770306049`: `sensor_offset`).
 pub fn plays(x: &[f64]) -> Vec<Term> {
     let (lo, hi) = crate::numerics::stats::min_max(x);
     let span = if hi > lo { hi - lo } else { 0.0 };
