@@ -22,8 +22,15 @@ const DEPENDENT: f64 = 1e-13;
 /// pivot are zero.
 pub fn reduced(j: &DMatrix<f64>, r: &[f64]) -> DMatrix<f64> {
     let (rows, n) = j.shape();
-    // `[r J]`'s columns (J is stored column by column).
-    let cols: Vec<&[f64]> = std::iter::once(r).chain((0..n).map(|c| &j.as_slice()[c * rows..(c + 1) * rows])).collect();
+    // J is stored column by column.
+    let cols: Vec<&[f64]> = (0..n).map(|c| &j.as_slice()[c * rows..(c + 1) * rows]).collect();
+    reduced_columns(&cols, r)
+}
+
+/// [`reduced`] for the Jacobian's columns as they were computed (no `m × n` matrix made).
+pub fn reduced_columns(j: &[&[f64]], r: &[f64]) -> DMatrix<f64> {
+    let n = j.len();
+    let cols: Vec<&[f64]> = std::iter::once(r).chain(j.iter().copied()).collect();
     let g = super::lstsq::gram(&cols);
     let mut u = DMatrix::<f64>::zeros(n + 1, n + 1);
     for k in 0..=n {
@@ -66,5 +73,9 @@ mod tests {
         assert!(((a.transpose() * &a) - j.transpose() * &j).amax() < 1e-9);
         assert!(((a.transpose() * &b) - j.transpose() * &rv).amax() < 1e-9);
         assert!((b.norm() - rv.norm()).abs() < 1e-12);
+        // The same matrix from the columns as computed, to the bit.
+        let cols: Vec<Vec<f64>> = (0..n).map(|c| j.column(c).iter().copied().collect()).collect();
+        let cols: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
+        assert_eq!(reduced_columns(&cols, &r), a);
     }
 }

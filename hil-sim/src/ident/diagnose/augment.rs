@@ -20,70 +20,14 @@
 //! term, so a gain is never the extra Gauss–Newton step.
 
 use rayon::prelude::*;
-use serde::Serialize;
 
+use super::fed::{Fed, Feeds};
 use super::projection::{self, Projection};
+use super::transform::Transform;
 use crate::ident::fit::simulate::{kinematics, Simulator};
 use crate::ident::fit::Dataset;
 use crate::models::search::{ModelSpec, Spacing};
 use crate::models::RateSpec;
-
-/// A change to what the base model is fed.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-pub enum Transform {
-    /// The output responds to the input `delay_s` later: the model sees `x(t − delay_s)`.
-    Delay { delay_s: f64 },
-    /// First-order lag `τ·ẋ_f = x − x_f` (Spencer's η filter with η = 1/τ).
-    Lag { tau_s: f64 },
-    /// Two first-order lags of `τ/2` each in series (a field diffusing through two layers:
-    /// its step response starts flat, between a first-order lag and a delay).
-    Lag2 { tau_s: f64 },
-    /// `b_s · tanh(x / b_s)`.
-    Saturate { b_sat: f64 },
-    /// A sharper knee, `x / (1 + (x / b_s)⁴)^¼`: linear up to near `b_s`, then flat (steel
-    /// saturating in a narrow range of the field).
-    SaturateKnee { b_sat: f64 },
-    /// The recorded input reads `b_0` high: the model sees `x − b_0`.
-    Offset { b_0: f64 },
-    /// First-order lags of `τ` forward and backward in time: the input smoothed without a
-    /// shift of phase. Never a finding: the control a field lag must beat ([`super::zero_phase`]).
-    Smooth { tau_s: f64 },
-}
-
-impl Transform {
-    /// The transformed input; `dt` is the sample interval (s).
-    pub fn apply(&self, x: &[f64], dt: f64) -> Vec<f64> {
-        match *self {
-            Self::Delay { delay_s } => crate::models::alignment::shift(x, -delay_s / dt),
-            Self::Lag { tau_s } => {
-                let a = if tau_s > 0.0 { (-dt / tau_s).exp() } else { 0.0 };
-                let mut f = x.first().copied().unwrap_or(0.0);
-                x.iter()
-                    .map(|v| {
-                        f = a * f + (1.0 - a) * v;
-                        f
-                    })
-                    .collect()
-            }
-            Self::Lag2 { tau_s } => {
-                let half = Self::Lag { tau_s: 0.5 * tau_s };
-                half.apply(&half.apply(x, dt), dt)
-            }
-            Self::Saturate { b_sat } => x.iter().map(|v| b_sat * (v / b_sat).tanh()).collect(),
-            Self::SaturateKnee { b_sat } => x.iter().map(|v| v / (1.0 + (v / b_sat).powi(4)).powf(0.25)).collect(),
-            Self::Offset { b_0 } => x.iter().map(|v| v - b_0).collect(),
-            Self::Smooth { tau_s } => {
-                let lag = Self::Lag { tau_s };
-                let mut f = lag.apply(x, dt);
-                f.reverse();
-                let mut b = lag.apply(&f, dt);
-                b.reverse();
-                b
-            }
-        }
-    }
-}
 
 /// One term linear in its coefficient.
 #[derive(Clone, Debug)]
@@ -176,6 +120,12 @@ impl Term {
     pub fn is_additive(&self) -> bool {
         matches!(self.kind, TermKind::Additive)
     }
+    /// A copy whose values, when they are a map of the input, are left empty for
+    /// [`Problem::through`] to make (not copied only to be replaced).
+    fn to_make_again(&self) -> Term {
+        let values = if self.of_input.is_some() { Vec::new() } else { self.values.clone() };
+        Term { name: self.name.clone(), values, kind: self.kind, of_input: self.of_input.clone() }
+    }
     /// Whether its weight is held ≥ 0: the cubic of the input, which would otherwise bend
     /// the base's curve over and take up a saturation.
     pub fn at_least_zero(&self) -> bool {
@@ -211,6 +161,8 @@ pub struct Problem<'a> {
     /// Cutoff (Hz) of the zero-phase rate of the given rates
     /// ([`crate::numerics::derivative::content_cutoff`]): a transformed input gets its rate the same way.
     pub rate_cutoff_hz: f64,
+    /// The feeds made so far ([`super::fed`]), shared with [`Problem::on_rows`]'s problems.
+    feeds: std::sync::Arc<Feeds>,
 }
 
 /// A refitted augmented model.
@@ -266,7 +218,7 @@ struct AugSim<'p, 'a> {
 const CACHED: usize = 2;
 
 /// Kinematics, transforms, terms and their least squares at one tuning value.
-type Piece = (Vec<model_core::Kin>, Vec<Transform>, Vec<Term>, Projection);
+type Piece = (std::sync::Arc<Fed>, Vec<Transform>, Vec<Term>, Projection);
 type CachedPiece = (u64, std::sync::Arc<Piece>);
 /// Base output, β, prediction, its mean squared error, transforms and terms (`AugSim::full`).
 type Full = (Vec<f64>, Vec<f64>, Vec<f64>, f64, Vec<Transform>, Vec<Term>);
@@ -283,17 +235,16 @@ impl AugSim<'_, '_> {
             }
         }
         let mut transforms = self.transforms.to_vec();
-        let mut terms = self.terms.to_vec();
+        let mut terms: Vec<Term> = self.terms.iter().map(Term::to_make_again).collect();
         if let Some(t) = self.tune {
             let (tr, extra) = (t.build)(g);
             transforms.extend(tr);
             terms.extend(extra);
         }
-        let x = self.prob.transformed(&transforms);
-        let kin = self.prob.kin_of(&x)?;
-        let terms = self.prob.through(terms, &transforms, &x);
+        let fed = self.prob.fed(&transforms)?;
+        let terms = self.prob.through(terms, &transforms, &fed.x);
         let projection = self.prob.projection(&terms);
-        let v = std::sync::Arc::new((kin, transforms, terms, projection));
+        let v = std::sync::Arc::new((fed, transforms, terms, projection));
         if let Ok(mut c) = self.cache.lock() {
             c.insert(0, (g.to_bits(), std::sync::Arc::clone(&v)));
             c.truncate(CACHED);
@@ -305,9 +256,10 @@ impl AugSim<'_, '_> {
         let theta = p.get(..self.n_base())?;
         let g = p.get(self.n_base()).copied().unwrap_or(0.0);
         let piece = self.at(g)?;
-        let (kin, transforms, terms, projection) = &*piece;
-        let m = self.prob.run_kin(theta, kin)?;
-        let (beta, pred, mse) = self.prob.solve_terms(terms, projection, &m, true)?;
+        let (fed, transforms, terms, projection) = &*piece;
+        let m = self.prob.run_kin(theta, &fed.kin)?;
+        let mut pred = m.clone();
+        let (beta, mse) = self.prob.add_terms(terms, projection, &mut pred, true)?;
         Some((m, beta, pred, mse, transforms.clone(), terms.clone()))
     }
 }
@@ -329,27 +281,38 @@ impl Simulator for AugSim<'_, '_> {
         else {
             return false;
         };
-        let (kin, _, terms, projection) = &*piece;
-        let Some(m) = kin.get(..out.len()).and_then(|k| self.prob.run_kin(theta, k)) else { return false };
-        let Some((_, pred, _)) = self.prob.solve_terms(terms, projection, &m, false) else { return false };
-        for (o, v) in out.iter_mut().zip(&pred) {
-            *o = *v;
+        let (fed, _, terms, projection) = &*piece;
+        // The base model's output, then the terms added to it, in `out` itself.
+        let Some(kin) = fed.kin.get(..out.len()) else { return false };
+        if !self.prob.sim.run(theta, kin, out) || self.prob.add_terms(terms, projection, out, false).is_none() {
+            return false;
         }
-        pred.iter().all(|v| v.is_finite())
+        out.iter().all(|v| v.is_finite())
     }
 }
 
 impl<'a> Problem<'a> {
+    /// The refits of `sim` (its search space `spec`, rate estimator `rate`) on `data`,
+    /// trained on the rows `train`; `rate_cutoff_hz` as [`Problem::rate_cutoff_hz`].
+    pub fn new(
+        data: &'a Dataset,
+        (sim, spec): (&'a dyn Simulator, &'a ModelSpec),
+        rate: RateSpec,
+        train: Vec<usize>,
+        rate_cutoff_hz: f64,
+    ) -> Self {
+        Problem { data, sim, spec, rate, train, rate_cutoff_hz, feeds: Default::default() }
+    }
+
     /// The same problem trained on `train` instead (another split of the recording).
     pub fn on_rows(&self, train: Vec<usize>) -> Problem<'a> {
         let (data, sim, spec, rate, rate_cutoff_hz) = (self.data, self.sim, self.spec, self.rate, self.rate_cutoff_hz);
-        Problem { data, sim, spec, rate, train, rate_cutoff_hz }
+        Problem { data, sim, spec, rate, train, rate_cutoff_hz, feeds: std::sync::Arc::clone(&self.feeds) }
     }
 
     /// The base model's output for `theta` fed the transformed input (`None` if it diverges).
     pub fn run(&self, theta: &[f64], transforms: &[Transform]) -> Option<Vec<f64>> {
-        let kin = self.kin(transforms)?;
-        self.run_kin(theta, &kin)
+        self.run_kin(theta, &self.fed(transforms)?.kin)
     }
 
     /// The recorded input through `transforms`.
@@ -378,8 +341,13 @@ impl<'a> Problem<'a> {
         terms
     }
 
-    fn kin(&self, transforms: &[Transform]) -> Option<Vec<model_core::Kin>> {
-        self.kin_of(&self.transformed(transforms))
+    /// The recorded input through `transforms` and its kinematics, made once ([`super::fed`]).
+    pub(super) fn fed(&self, transforms: &[Transform]) -> Option<std::sync::Arc<Fed>> {
+        self.feeds.get_or_make(transforms, || {
+            let x = self.transformed(transforms);
+            let kin = self.kin_of(&x)?;
+            Some(Fed { x, kin })
+        })
     }
 
     /// The base model's kinematics for the (transformed) input `x`.
@@ -426,16 +394,16 @@ impl<'a> Problem<'a> {
         Projection::new(&fixed, &self.train).at_least_zero(terms.iter().map(Term::at_least_zero).collect())
     }
 
-    /// β for fixed θ (model output `m`): least squares of `y − m` on the terms' columns
-    /// (`projection`: the terms' own); the prediction, and the training MSE when `with_mse`
-    /// (NaN otherwise).
-    fn solve_terms(
+    /// β for fixed θ (the model output `m`, which becomes the prediction): least squares of
+    /// `y − m` on the terms' columns (`projection`: the terms' own), and the training MSE when
+    /// `with_mse` (NaN otherwise).
+    fn add_terms(
         &self,
         terms: &[Term],
         projection: &Projection,
-        m: &[f64],
+        m: &mut [f64],
         with_mse: bool,
-    ) -> Option<(Vec<f64>, Vec<f64>, f64)> {
+    ) -> Option<(Vec<f64>, f64)> {
         let cols: Vec<std::borrow::Cow<'_, [f64]>> = terms.iter().map(|t| t.column(m)).collect();
         let varying: Vec<&[f64]> =
             terms.iter().zip(&cols).filter(|(t, _)| !t.is_additive()).map(|(_, c)| &**c).collect();
@@ -444,13 +412,12 @@ impl<'a> Problem<'a> {
         } else {
             (projection.coefficients_for(&varying, &self.data.output, m)?, f64::NAN)
         };
-        let mut pred = m.to_vec();
         for (c, b) in cols.iter().zip(&beta) {
-            for (p, v) in pred.iter_mut().zip(c.iter()) {
+            for (p, v) in m.iter_mut().zip(c.iter()) {
                 *p += b * v;
             }
         }
-        Some((beta, pred, mse))
+        Some((beta, mse))
     }
 
     /// Refit θ, β and the candidate's value of the model `transforms` + `terms` (+ what
@@ -514,9 +481,9 @@ impl<'a> Problem<'a> {
     /// Jacobian `jac` (taken at the current transforms) stands in for the refit of θ. One
     /// run of the base model, for scanning a candidate's grid cheaply.
     pub fn scan_cost(&self, transforms: &[Transform], terms: &[Term], theta: &[f64], jac: &[Vec<f64>]) -> Option<f64> {
-        let x = self.transformed(transforms);
-        let m = self.run_kin(theta, &self.kin_of(&x)?)?;
-        let terms = self.through(terms.to_vec(), transforms, &x);
+        let fed = self.fed(transforms)?;
+        let m = self.run_kin(theta, &fed.kin)?;
+        let terms = self.through(terms.to_vec(), transforms, &fed.x);
         let term_cols: Vec<std::borrow::Cow<'_, [f64]>> = terms.iter().map(|t| t.column(&m)).collect();
         let cols: Vec<&[f64]> = jac.iter().map(Vec::as_slice).chain(term_cols.iter().map(|c| &**c)).collect();
         let target: Vec<f64> = self.data.output.iter().zip(&m).map(|(y, m)| y - m).collect();
@@ -525,9 +492,9 @@ impl<'a> Problem<'a> {
 
     /// The base model's Jacobian at `theta` through `transforms`.
     pub fn jacobian_at(&self, theta: &[f64], transforms: &[Transform]) -> Option<Vec<Vec<f64>>> {
-        let kin = self.kin(transforms)?;
-        let m0 = self.run_kin(theta, &kin)?;
-        Some(self.jacobian(theta, &kin, &m0))
+        let fed = self.fed(transforms)?;
+        let m0 = self.run_kin(theta, &fed.kin)?;
+        Some(self.jacobian(theta, &fed.kin, &m0))
     }
 }
 
@@ -537,23 +504,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn transforms_do_what_they_say() {
-        let dt = 1e-3;
-        let x: Vec<f64> = (0..200).map(|i| (i as f64 * 0.05).sin()).collect();
-        // A delay of 3 samples: the model sees x three samples earlier.
-        let d = Transform::Delay { delay_s: 3e-3 }.apply(&x, dt);
-        assert!((d[50] - x[47]).abs() < 1e-12);
-        // A first-order lag keeps a constant and attenuates a step's start.
-        let step: Vec<f64> = (0..100).map(|i| if i < 10 { 0.0 } else { 1.0 }).collect();
-        let l = Transform::Lag { tau_s: 5e-3 }.apply(&step, dt);
-        assert!((l[14] - (1.0 - (-5.0f64 / 5.0).exp())).abs() < 1e-9, "{}", l[14]);
-        assert!((l[99] - 1.0).abs() < 1e-6);
-        let s = Transform::Saturate { b_sat: 0.5 }.apply(&[2.0, -2.0, 0.0], dt);
-        assert!(s[0] < 0.5 && s[0] > 0.49 && s[1] == -s[0] && s[2] == 0.0);
-        assert_eq!(Transform::Offset { b_0: 0.1 }.apply(&[1.0], dt), vec![0.9]);
-    }
-
-    #[test]
     fn a_map_of_the_input_is_made_again_from_the_input_through_the_transforms_it_follows() {
         let x: Vec<f64> = (0..300).map(|i| 0.8 * (i as f64 * 0.03).sin()).collect();
         use rand::SeedableRng;
@@ -561,14 +511,7 @@ mod tests {
         let data = crate::ident::diagnose::tests::with_noise(x.clone(), &vec![0.0; x.len()], rng);
         let spec = crate::models::host("algebraic").and_then(|h| h.spec(&data.scales(), None)).unwrap();
         let sim = crate::ident::fit::simulate::simulator("algebraic", 1e-3).unwrap();
-        let prob = Problem {
-            data: &data,
-            sim: sim.as_ref(),
-            spec: &spec,
-            rate: spec.rate,
-            train: vec![],
-            rate_cutoff_hz: 50.0,
-        };
+        let prob = Problem::new(&data, (sim.as_ref(), &spec), spec.rate, vec![], 50.0);
         let (sat, lag) = (Transform::Saturate { b_sat: 0.4 }, Transform::Lag { tau_s: 0.02 });
         let both = [sat.clone(), lag.clone()];
         let seen = prob.transformed(&both);

@@ -19,7 +19,7 @@
 
 use serde::Serialize;
 
-use super::augment::{Fitted, Term, Transform};
+use super::{augment::Fitted, augment::Term, transform::Transform};
 use crate::ident::fit::Dataset;
 use crate::numerics::log_spaced;
 use crate::numerics::stats::{mean, min_max, std};

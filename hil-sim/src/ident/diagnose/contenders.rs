@@ -89,14 +89,8 @@ pub struct Shared<'a, 'b> {
 /// The first round on `base`, with play operators when `with_plays`.
 pub fn open<'a>(base: &'a Base, s: &Shared<'a, '_>, with_plays: bool) -> Result<Opening<'a>, DiagnoseError> {
     let diverges = || DiagnoseError::Diverges(base.fit.model.clone());
-    let prob = Problem {
-        data: s.data,
-        sim: base.sim.as_ref(),
-        spec: &base.spec,
-        rate: base.fit.rate_choice,
-        train: s.train.to_vec(),
-        rate_cutoff_hz: s.rate_cutoff_hz,
-    };
+    let prob =
+        Problem::new(s.data, (base.sim.as_ref(), &base.spec), base.fit.rate_choice, s.train.to_vec(), s.rate_cutoff_hz);
     // Run on from the fit until it stalls, so that a term is never credited with what more
     // iterations of the base would have done.
     let terms = if with_plays { plays(&s.data.input) } else { Vec::new() };
@@ -266,11 +260,11 @@ mod tests {
     /// radii unlike [`PLAY_RADII`] on a linear static curve, as no seed model has it), the
     /// field seen through `lag_s` (0: none), with white noise of 0.5 % of the span.
     fn play_clutch(lag_s: f64, seed: u64) -> crate::ident::fit::Dataset {
-        play_clutch_seeing(super::super::augment::Transform::Lag { tau_s: lag_s }, seed)
+        play_clutch_seeing(super::super::transform::Transform::Lag { tau_s: lag_s }, seed)
     }
 
     /// [`play_clutch`] with the field seen through `seen`.
-    fn play_clutch_seeing(seen: super::super::augment::Transform, seed: u64) -> crate::ident::fit::Dataset {
+    fn play_clutch_seeing(seen: super::super::transform::Transform, seed: u64) -> crate::ident::fit::Dataset {
         let (dt, n) = (1e-3, 12_000);
         let time: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
         let tone = |t: f64, f: f64, a: f64, ph: f64| a * (std::f64::consts::TAU * f * t + ph).sin();
@@ -318,7 +312,7 @@ mod tests {
         // The whole clutch, its plays included, sees the field levelling off: 15 % lower at
         // the top of the field (0.6). The plays follow the saturated field in the refit, and
         // the algebraic host cannot bend its own curve over to absorb it.
-        let sat = super::super::augment::Transform::Saturate { b_sat: 0.8 };
+        let sat = super::super::transform::Transform::Saturate { b_sat: 0.8 };
         let (found, notes) = effects(&play_clutch_seeing(sat, 7));
         assert_eq!(found.first().map(String::as_str), Some("saturation"), "{found:?} {notes:?}");
     }

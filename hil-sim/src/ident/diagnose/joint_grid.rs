@@ -57,8 +57,8 @@ fn best_points(prob: &Problem<'_>, reference: &Fitted, pieces: &[Option<Vec<Term
     let n_model = prob.sim.n_params();
     let free: Vec<usize> = prob.spec.free().into_iter().filter(|&j| j < n_model).collect();
     let Some(grid) = Grid::of(prob.spec, &free, affine, &reference.theta) else { return none };
-    let x = prob.transformed(&reference.transforms);
-    let Some(kin) = prob.kin_of(&x) else { return none };
+    let Some(fed) = prob.fed(&reference.transforms) else { return none };
+    let (x, kin) = (&fed.x, &fed.kin);
     // Each piece's columns, by index into one matrix of them all.
     let mut columns: Vec<Vec<f64>> = Vec::new();
     let mut of_piece: Vec<Option<Vec<usize>>> = Vec::with_capacity(pieces.len());
@@ -66,7 +66,7 @@ fn best_points(prob: &Problem<'_>, reference: &Fitted, pieces: &[Option<Vec<Term
         let terms = terms.as_ref().filter(|t| !t.is_empty() && t.iter().all(Term::is_additive));
         of_piece.push(terms.map(|terms| {
             let at = columns.len();
-            let terms = prob.through(terms.clone(), &reference.transforms, &x);
+            let terms = prob.through(terms.clone(), &reference.transforms, x);
             columns.extend(terms.into_iter().map(|t| t.values));
             (at..columns.len()).collect()
         }));
@@ -84,7 +84,7 @@ fn best_points(prob: &Problem<'_>, reference: &Fitted, pieces: &[Option<Vec<Term
     let piece_cols: Vec<&[f64]> = columns.iter().map(Vec::as_slice).collect();
     let (c_mat, y) = (matrix(&piece_cols), on_rows(&prob.data.output));
     let g_cc = c_mat.tr_mul(&c_mat);
-    let run = |q: &[f64]| prob.run_kin(q, &kin);
+    let run = |q: &[f64]| prob.run_kin(q, kin);
     // At each grid point, every piece's training SSE and solved affine values.
     let per_point: Vec<(usize, Vec<Solved>)> = grid
         .points
@@ -148,7 +148,7 @@ mod tests {
     /// The refit problem of `sim` on `data`, trained on its training part.
     fn problem<'a>(data: &'a Dataset, sim: &'a dyn Simulator, spec: &'a ModelSpec) -> Problem<'a> {
         let train = (0..data.train_end).collect();
-        Problem { data, sim, spec, rate: RateSpec::Backward, train, rate_cutoff_hz: 100.0 }
+        Problem::new(data, (sim, spec), RateSpec::Backward, train, 100.0)
     }
 
     /// A tanh clutch (seed 000 eq. 11) with a `|ḃ|·ḃ` term at 5 % of its span, under two

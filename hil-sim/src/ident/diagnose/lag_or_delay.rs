@@ -16,9 +16,10 @@
 use rayon::prelude::*;
 use serde::Serialize;
 
-use super::augment::{Fitted, Problem, Transform, Tune};
+use super::augment::{Fitted, Problem, Tune};
 use super::candidates::Candidate;
 use super::rank::Scored;
+use super::transform::Transform;
 
 /// Levenberg–Marquardt iterations of each share's refit.
 pub const PROFILE_ITERATIONS: usize = 20;

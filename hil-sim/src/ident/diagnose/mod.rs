@@ -42,6 +42,7 @@ pub mod contenders;
 pub mod decimate;
 pub mod describe;
 pub mod diagnosis;
+pub mod fed;
 pub mod joint_grid;
 pub mod lag_or_delay;
 pub mod leak;
@@ -57,6 +58,7 @@ pub mod refit;
 pub mod replicate;
 pub mod scan;
 pub mod significance;
+pub mod transform;
 pub mod zero_phase;
 
 use std::time::Instant;
@@ -64,9 +66,9 @@ use std::time::Instant;
 use crate::ident::fit::Dataset;
 use crate::progress::Progress;
 use accept::Judge;
-use augment::Transform;
 use candidates::Role;
 use describe::Described;
+use transform::Transform;
 
 pub use base::AUTO_BASES;
 pub use describe::unit_of;
@@ -384,14 +386,8 @@ mod tests {
         let opts = DiagnoseOptions { model: Some("bouc_wen".into()), ..Default::default() };
         let bases = base::fit_bases(data, &["bouc_wen"], &opts, &crate::progress::NoProgress).unwrap();
         let b = &bases.contenders[0];
-        let prob = Problem {
-            data,
-            sim: b.sim.as_ref(),
-            spec: &b.spec,
-            rate: b.fit.rate_choice,
-            train: base::rows(data).0,
-            rate_cutoff_hz: crate::numerics::derivative::CUTOFF_OF_FS / data.dt,
-        };
+        let cutoff = crate::numerics::derivative::CUTOFF_OF_FS / data.dt;
+        let prob = Problem::new(data, (b.sim.as_ref(), &b.spec), b.fit.rate_choice, base::rows(data).0, cutoff);
         let current = prob.refit(&[], &[], None, &b.fit.flat, 8).unwrap().0;
         let reference = rank::reference(&prob, &current).unwrap();
         let cands = candidates::all(data, &candidates::classify(data, vec![], None), false, prob.rate_cutoff_hz);

@@ -165,8 +165,9 @@ fn narrowing_loop(term: &str, coef: f64, x: &[f64]) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ident::diagnose::augment::{Term, Transform};
+    use crate::ident::diagnose::augment::Term;
     use crate::ident::diagnose::candidates::{Piece, DELAY_BOX};
+    use crate::ident::diagnose::transform::Transform;
 
     /// The yield-stress candidate, and a model spanning 0–4 N·m refitted with its term at
     /// coefficient `k`.

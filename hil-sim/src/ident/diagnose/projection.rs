@@ -29,12 +29,12 @@ impl Scaled {
 
 /// `values` on `rows`; `None` when a row is past its end.
 fn gather(values: &[f64], rows: &[usize]) -> Option<Vec<f64>> {
-    rows.iter().map(|&i| values.get(i).copied()).collect()
+    crate::numerics::on_rows(rows, |i| values.get(i).copied())
 }
 
 /// `output − model` on `rows`; `None` when a row is past the end of either.
 fn difference(output: &[f64], model: &[f64], rows: &[usize]) -> Option<Vec<f64>> {
-    rows.iter().map(|&i| Some(output.get(i)? - model.get(i)?)).collect()
+    crate::numerics::on_rows(rows, |i| Some(output.get(i)? - model.get(i)?))
 }
 
 /// A column of a [`Projection`].

@@ -90,8 +90,8 @@ impl<'p, 'a> Reversed<'p, 'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ident::diagnose::augment::Transform;
     use crate::ident::diagnose::tests::{recording, round_one};
+    use crate::ident::diagnose::transform::Transform;
 
     /// The first-order field lag candidate of round 1 on a Bouc–Wen base, replicated on the
     /// reversed split of `data`.

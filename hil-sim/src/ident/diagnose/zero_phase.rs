@@ -15,11 +15,12 @@
 
 use serde::Serialize;
 
-use super::augment::{Fitted, Problem, Transform};
+use super::augment::{Fitted, Problem};
 use super::candidates::{Candidate, Piece};
 use super::rank::{Scored, POLISH_ITERATIONS, SCREEN_ITERATIONS};
 use super::refit::refit_candidate;
 use super::significance::{self, Test};
+use super::transform::Transform;
 
 /// The zero-phase control of a field lag.
 #[derive(Clone, Copy, Debug, Serialize)]

@@ -123,7 +123,7 @@ impl<'a> Objective<'a> {
     /// Scaled residuals at `p`, `None` when the model rejects `p` or diverges.
     pub fn residuals(&self, p: &[f64]) -> Option<Vec<f64>> {
         let inv = 1.0 / self.scale;
-        self.simulate(p, |out| self.rows.iter().map(|&i| Some((out.get(i)? - self.y.get(i)?) * inv)).collect())
+        self.simulate(p, |out| crate::numerics::on_rows(self.rows, |i| Some((out.get(i)? - self.y.get(i)?) * inv)))
     }
 
     /// The kinematics shifted by `(d, d_u)` samples, from the cache when the delays are
@@ -150,28 +150,40 @@ impl<'a> Objective<'a> {
     /// Mean squared scaled residual (∞ when invalid): [`crate::numerics::stats::mean_square`]
     /// of [`Objective::residuals`], summed as it sums them, without the residual vector.
     pub fn cost(&self, p: &[f64]) -> f64 {
-        let inv = 1.0 / self.scale;
-        let sum = self.simulate(p, |out| {
-            let mut bad = false;
-            let s = self
-                .rows
-                .iter()
-                .map(|&i| match (out.get(i), self.y.get(i)) {
-                    (Some(o), Some(y)) => {
-                        let r = (o - y) * inv;
-                        r * r
-                    }
-                    _ => {
-                        bad = true;
-                        0.0
-                    }
-                })
-                .sum::<f64>();
-            (!bad).then_some(s)
-        });
+        self.cost_of(self.simulate(p, |out| self.squares(out)))
+    }
+
+    /// [`Objective::cost`] of the residuals [`Objective::residuals`] gave (the same number).
+    pub fn cost_of_residuals(&self, r: &[f64]) -> f64 {
+        self.cost_of((r.len() == self.rows.len()).then(|| r.iter().map(|r| r * r).sum::<f64>()))
+    }
+
+    fn cost_of(&self, sum: Option<f64>) -> f64 {
         match sum {
             Some(s) if !self.rows.is_empty() => s / self.rows.len() as f64,
             _ => f64::INFINITY,
         }
+    }
+
+    /// The sum of the squared scaled residuals of the output `out` (`None` when a row is
+    /// past its end).
+    fn squares(&self, out: &[f64]) -> Option<f64> {
+        let inv = 1.0 / self.scale;
+        let mut bad = false;
+        let s = self
+            .rows
+            .iter()
+            .map(|&i| match (out.get(i), self.y.get(i)) {
+                (Some(o), Some(y)) => {
+                    let r = (o - y) * inv;
+                    r * r
+                }
+                _ => {
+                    bad = true;
+                    0.0
+                }
+            })
+            .sum::<f64>();
+        (!bad).then_some(s)
     }
 }

@@ -107,13 +107,15 @@ pub fn kinematics(samples: &[Sample], dt: f32, rate: RateSpec) -> Option<Vec<Kin
 /// [`kinematics`] with the estimator restarted at every run start in `starts`.
 pub fn kinematics_runs(samples: &[Sample], dt: f32, rate: RateSpec, starts: &[usize]) -> Option<Vec<Kin>> {
     let params = rate.build(dt).ok()?;
+    // Every sample carries both rates (the zero-phase ones): the estimator's would be unused.
+    let given = samples.iter().all(|s| s.dx.is_some() && s.ddx.is_some());
     let mut st = RateState::default();
     let mut out = Vec::with_capacity(samples.len());
     for (i, s) in samples.iter().enumerate() {
         if i > 0 && starts.contains(&i) {
             st = RateState::default();
         }
-        let (dx, ddx) = params.step(&mut st, s.x);
+        let (dx, ddx) = if given { (0.0, 0.0) } else { params.step(&mut st, s.x) };
         let k = Kin { x: s.x, dx: s.dx.unwrap_or(dx), ddx: s.ddx.unwrap_or(ddx), u: s.u.unwrap_or(0.0) };
         if !k.is_finite() {
             return None;
@@ -127,6 +129,27 @@ pub fn kinematics_runs(samples: &[Sample], dt: f32, rate: RateSpec, starts: &[us
 mod tests {
     use super::*;
     use crate::models::replay;
+
+    #[test]
+    fn given_rates_win_and_the_estimator_runs_on_for_the_samples_without() {
+        let dt = 1e-3f32;
+        let x: Vec<f32> = (0..400).map(|i| (i as f32 * 0.05).sin()).collect();
+        let plain: Vec<Sample> = x.iter().map(|v| Sample::new(*v)).collect();
+        let with = |s: Sample, i: usize| Sample { dx: Some(i as f32), ddx: Some(-(i as f32)), ..s };
+        let all: Vec<Sample> = plain.iter().enumerate().map(|(i, s)| with(*s, i)).collect();
+        // Rates on the first half only: the second half's must be the estimator's own.
+        let half: Vec<Sample> = plain.iter().enumerate().map(|(i, s)| if i < 200 { with(*s, i) } else { *s }).collect();
+        for rate in [RateSpec::Backward, RateSpec::Filtered { fc: 50.0 }] {
+            let est = kinematics_runs(&plain, dt, rate, &[150]).unwrap();
+            let given = kinematics_runs(&all, dt, rate, &[150]).unwrap();
+            let mixed = kinematics_runs(&half, dt, rate, &[150]).unwrap();
+            for i in 0..x.len() {
+                assert_eq!((given[i].x, given[i].dx, given[i].ddx), (x[i], i as f32, -(i as f32)));
+                let want = if i < 200 { given[i] } else { est[i] };
+                assert_eq!((mixed[i].dx, mixed[i].ddx), (want.dx, want.ddx), "{i}");
+            }
+        }
+    }
 
     #[test]
     fn matches_the_estimator_replay() {
