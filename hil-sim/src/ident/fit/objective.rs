@@ -99,8 +99,12 @@ impl<'a> Objective<'a> {
             static OUT: std::cell::RefCell<Vec<f64>> = const { std::cell::RefCell::new(Vec::new()) };
         }
         let run = |out: &mut Vec<f64>| -> Option<T> {
-            out.clear();
-            out.resize(self.end, 0.0);
+            // Every simulator writes each sample it is given ([`Simulator::run`]): a buffer of
+            // the right length is written over, not cleared first.
+            if out.len() != self.end {
+                out.clear();
+                out.resize(self.end, 0.0);
+            }
             let (d, d_u) = self.delays(p);
             let ok = if d == 0.0 && d_u == 0.0 {
                 self.sim.run(self.model_params(p), self.kin.get(..self.end)?, out)

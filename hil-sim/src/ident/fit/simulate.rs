@@ -17,7 +17,8 @@ pub trait Simulator: Send + Sync {
     fn n_params(&self) -> usize;
     /// Whether `p` is a valid parameter set (the model's own constructor decides).
     fn valid(&self, p: &[f64]) -> bool;
-    /// Run from rest over `kin`, writing one output per sample into `out`. `false` when the
+    /// Run from rest over `kin`, writing one output per sample into `out` (every sample up to
+    /// the shorter of the two: the objective reuses `out` without clearing it). `false` when the
     /// parameters are invalid or the output stops being finite. The state restarts at every
     /// run start ([`Simulator::run_starts`]).
     fn run(&self, p: &[f64], kin: &[Kin], out: &mut [f64]) -> bool;
@@ -172,6 +173,45 @@ mod tests {
                 assert_eq!(*a, f64::from(*b));
             }
         }
+    }
+
+    #[test]
+    fn every_sample_is_written_whatever_the_buffer_held() {
+        let dt = 1e-3f32;
+        let samples: Vec<Sample> = (0..1500)
+            .map(|i| {
+                let t = i as f32 * dt;
+                Sample::new(0.4 + 0.3 * (5.0 * t).sin()).with_command(1.0 + 0.5 * (3.0 * t).sin())
+            })
+            .collect();
+        let kin = kinematics(&samples, dt, RateSpec::Backward).unwrap();
+        let scales = crate::models::search::Scales {
+            x_mean: 0.4,
+            x: 0.2,
+            dx: 1.0,
+            ddx: 5.0,
+            y_mean: 2.0,
+            y: 1.0,
+            u: Some(1.5),
+            fs: 1000.0,
+        };
+        let mut ran = 0;
+        // Every model of the registry with a search space (the parametric ones and more).
+        for id in model_core::registry::MODELS.iter().map(|m| m.id) {
+            let (Some(sim), Some(spec)) =
+                (simulator_runs(id, dt, &[0, 700]), crate::models::host(id).and_then(|h| h.spec(&scales, None)))
+            else {
+                continue;
+            };
+            let p = spec.start();
+            let (mut zeros, mut nans) = (vec![0.0; kin.len()], vec![f64::NAN; kin.len()]);
+            assert_eq!(sim.run(&p, &kin, &mut zeros), sim.run(&p, &kin, &mut nans), "{id}");
+            if sim.run(&p, &kin, &mut nans) {
+                assert_eq!(zeros, nans, "{id}");
+                ran += 1;
+            }
+        }
+        assert!(ran >= 8, "only {ran} models ran from their start");
     }
 
     #[test]
