@@ -87,7 +87,7 @@ use crate::math::{abs, clamp, powf, sign};
 use crate::model::write_flat;
 use crate::models::kernels::turning::{turning_point, TURN_EPS};
 use crate::{Finite, Kin, Model, ParamError};
-use region::{region_n1, region_n2, Leg};
+use region::{region_n1, region_n2, Leg, Roots};
 
 mod region;
 
@@ -153,6 +153,10 @@ pub struct BoucWen {
     turn_k: f32,
     q_by_sign: [f32; 2],
     k_x0: f32,
+    /// `(√|p/q|, √|p·q|)` of the regions w > 0 (`p = δ`, `q = q_pos`) and w < 0 (`p = −δ`,
+    /// `q = q_neg`): the Riccati solution's level and rate for n = 2 ([`region::Roots`]),
+    /// taken once rather than every step.
+    roots: [Roots; 2],
 }
 
 /// Read access to the validated parameters (set only by `new`/`from_params`).
@@ -314,6 +318,7 @@ impl BoucWen {
             turn_k: if fast_q.is_finite() { fast_q * dt * dt * (FAST_Y / TURN_EPS) } else { 0.0 },
             q_by_sign: [beta + gamma, gamma - beta],
             k_x0: k * x0,
+            roots: [Roots::of(delta, beta + gamma), Roots::of(-delta, gamma - beta)],
         })
     }
 
@@ -413,8 +418,9 @@ impl BoucWen {
         let mut rem = l;
         // After a crossing the new region has p > 0, so at most one crossing per leg.
         for _ in 0..2 {
-            let (p, q) = if pos { (self.delta, self.q_pos) } else { (-self.delta, self.q_neg) };
-            let r = if self.exp == Exponent::One { region_n1(v, rem, p, q) } else { region_n2(v, rem, p, q) };
+            let (p, q, roots) =
+                if pos { (self.delta, self.q_pos, self.roots[0]) } else { (-self.delta, self.q_neg, self.roots[1]) };
+            let r = if self.exp == Exponent::One { region_n1(v, rem, p, q) } else { region_n2(v, rem, p, q, roots) };
             match r {
                 Leg::Done(v1) => return if pos { v1 } else { -v1 },
                 Leg::Crossed(r) => {

@@ -2,7 +2,7 @@
 //! (exponential) and `n = 2` (Riccati: `tanh`/`tan` forms), stopping where `w` reaches 0
 //! (module docs of [`bouc_wen`](super)).
 
-use crate::math::{atan, expm1, sqrt, tan, tanh};
+use crate::math::{abs, atan, expm1, sqrt, tan, tanh};
 
 /// Result of integrating one sign region.
 pub(super) enum Leg {
@@ -31,8 +31,30 @@ pub(super) fn region_n1(v0: f32, l: f32, p: f32, q: f32) -> Leg {
     Leg::Done(v0 + f0 * phi(l))
 }
 
-/// `dv/dξ = p − q·v²` from `v0 ≥ 0` over `l`, stopping at `v = 0` (exact Riccati).
-pub(super) fn region_n2(v0: f32, l: f32, p: f32, q: f32) -> Leg {
+/// The level `s = √|p/q|` and rate `r = √|p·q|` of a region's Riccati solution (n = 2),
+/// fixed by the parameters: the same bits as taken in each branch of [`region_n2`] (a
+/// quotient's or product's magnitude does not depend on the operands' signs), two square
+/// roots and a division fewer per step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Roots {
+    s: f32,
+    r: f32,
+}
+
+impl Roots {
+    /// The roots of the region with `p` and `q` (zero when `q = 0`, where they are not used).
+    pub(super) fn of(p: f32, q: f32) -> Self {
+        if q == 0.0 {
+            return Self { s: 0.0, r: 0.0 };
+        }
+        Self { s: sqrt(abs(p / q)), r: sqrt(abs(p * q)) }
+    }
+}
+
+/// `dv/dξ = p − q·v²` from `v0 ≥ 0` over `l`, stopping at `v = 0` (exact Riccati);
+/// `roots`: [`Roots::of`] `p` and `q`.
+pub(super) fn region_n2(v0: f32, l: f32, p: f32, q: f32, roots: Roots) -> Leg {
+    let Roots { s, r } = roots;
     if q == 0.0 {
         let v = v0 + p * l;
         if p < 0.0 && v <= 0.0 {
@@ -44,8 +66,7 @@ pub(super) fn region_n2(v0: f32, l: f32, p: f32, q: f32) -> Leg {
     if p > 0.0 {
         if q > 0.0 {
             // v = s·tanh(rξ + atanh(v0/s)) in Möbius form (valid for v0 > s too).
-            let s = sqrt(p / q);
-            let t = tanh(sqrt(p * q) * l);
+            let t = tanh(r * l);
             return Leg::Done(s * (v0 + s * t) / (s + v0 * t));
         }
         // p > 0 > q: finite-distance blow-up; outside the validated class.
@@ -53,8 +74,6 @@ pub(super) fn region_n2(v0: f32, l: f32, p: f32, q: f32) -> Leg {
     }
     if q > 0.0 {
         // dv/dξ = −(|p| + q v²): v = s·tan(atan(v0/s) − rξ).
-        let s = sqrt(-p / q);
-        let r = sqrt(-p * q);
         let th = atan(v0 / s);
         let rl = r * l;
         if rl >= th {
@@ -66,11 +85,9 @@ pub(super) fn region_n2(v0: f32, l: f32, p: f32, q: f32) -> Leg {
         return Leg::Done(if v > 0.0 { v } else { 0.0 });
     }
     // p < 0, q < 0: dv/dξ = −|q|(s² − v²), v = s·tanh(atanh(v0/s) − rξ) while v0 < s.
-    let s = sqrt(p / q);
     if v0 >= s {
         return Leg::Done(v0);
     }
-    let r = sqrt(p * q);
     let u = v0 / s;
     let t = tanh(r * l);
     if t >= u {
