@@ -23,6 +23,7 @@ use rayon::prelude::*;
 
 use super::fed::{Fed, Feeds};
 use super::projection::{self, Projection};
+use super::runs::Runs;
 use super::transform::Transform;
 use crate::ident::fit::simulate::{kinematics, Simulator};
 use crate::ident::fit::Dataset;
@@ -161,8 +162,10 @@ pub struct Problem<'a> {
     /// Cutoff (Hz) of the zero-phase rate of the given rates
     /// ([`crate::numerics::derivative::content_cutoff`]): a transformed input gets its rate the same way.
     pub rate_cutoff_hz: f64,
-    /// The feeds made so far ([`super::fed`]), shared with [`Problem::on_rows`]'s problems.
+    /// The feeds made so far ([`super::fed`]), shared with [`Problem::on_rows`]'s problems…
     feeds: std::sync::Arc<Feeds>,
+    /// …and the base model's outputs run last ([`super::runs`]).
+    runs: std::sync::Arc<Runs>,
 }
 
 /// A refitted augmented model.
@@ -251,13 +254,32 @@ impl AugSim<'_, '_> {
         }
         Some(v)
     }
+    /// The training MSE at `p` ([`AugSim::full`]'s), the base model run up to the last
+    /// training row only (so a run that diverges after it no longer fails). A term whose
+    /// column depends on the whole output (the output's saturation, from its floor) gets
+    /// the whole run.
+    fn train_mse(&self, p: &[f64]) -> Option<f64> {
+        let theta = p.get(..self.n_base())?;
+        let piece = self.at(p.get(self.n_base()).copied().unwrap_or(0.0))?;
+        let (fed, transforms, terms, projection) = &*piece;
+        if terms.iter().any(|t| matches!(t.kind, TermKind::OutputSaturation { .. })) {
+            return self.full(p).map(|f| f.3);
+        }
+        let len = self.prob.train.last().map_or(0, |&i| i + 1);
+        let kin = fed.kin.get(..len)?;
+        let mut m = vec![0.0; len];
+        if !self.prob.runs.run_into(transforms, theta, &mut m, |out| self.prob.sim.run(theta, kin, out)) {
+            return None;
+        }
+        self.prob.add_terms(terms, projection, &mut m, true).map(|(_, mse)| mse)
+    }
     /// The base output, β and the prediction over the whole recording for `p`.
     fn full(&self, p: &[f64]) -> Option<Full> {
         let theta = p.get(..self.n_base())?;
         let g = p.get(self.n_base()).copied().unwrap_or(0.0);
         let piece = self.at(g)?;
         let (fed, transforms, terms, projection) = &*piece;
-        let m = self.prob.run_kin(theta, &fed.kin)?;
+        let m = self.prob.run_fed(theta, transforms, fed)?;
         let mut pred = m.clone();
         let (beta, mse) = self.prob.add_terms(terms, projection, &mut pred, true)?;
         Some((m, beta, pred, mse, transforms.clone(), terms.clone()))
@@ -281,10 +303,11 @@ impl Simulator for AugSim<'_, '_> {
         else {
             return false;
         };
-        let (fed, _, terms, projection) = &*piece;
+        let (fed, transforms, terms, projection) = &*piece;
         // The base model's output, then the terms added to it, in `out` itself.
         let Some(kin) = fed.kin.get(..out.len()) else { return false };
-        if !self.prob.sim.run(theta, kin, out) || self.prob.add_terms(terms, projection, out, false).is_none() {
+        let ran = self.prob.runs.run_into(transforms, theta, out, |out| self.prob.sim.run(theta, kin, out));
+        if !ran || self.prob.add_terms(terms, projection, out, false).is_none() {
             return false;
         }
         out.iter().all(|v| v.is_finite())
@@ -301,18 +324,28 @@ impl<'a> Problem<'a> {
         train: Vec<usize>,
         rate_cutoff_hz: f64,
     ) -> Self {
-        Problem { data, sim, spec, rate, train, rate_cutoff_hz, feeds: Default::default() }
+        let (feeds, runs) = Default::default();
+        Problem { data, sim, spec, rate, train, rate_cutoff_hz, feeds, runs }
     }
 
     /// The same problem trained on `train` instead (another split of the recording).
     pub fn on_rows(&self, train: Vec<usize>) -> Problem<'a> {
         let (data, sim, spec, rate, rate_cutoff_hz) = (self.data, self.sim, self.spec, self.rate, self.rate_cutoff_hz);
-        Problem { data, sim, spec, rate, train, rate_cutoff_hz, feeds: std::sync::Arc::clone(&self.feeds) }
+        let (feeds, runs) = (std::sync::Arc::clone(&self.feeds), std::sync::Arc::clone(&self.runs));
+        Problem { data, sim, spec, rate, train, rate_cutoff_hz, feeds, runs }
     }
 
     /// The base model's output for `theta` fed the transformed input (`None` if it diverges).
     pub fn run(&self, theta: &[f64], transforms: &[Transform]) -> Option<Vec<f64>> {
-        self.run_kin(theta, &self.fed(transforms)?.kin)
+        let fed = self.fed(transforms)?;
+        self.run_fed(theta, transforms, &fed)
+    }
+
+    /// The base model's output for `theta` fed `fed` (the input through `transforms`), over
+    /// the whole recording: kept or run ([`super::runs`]).
+    fn run_fed(&self, theta: &[f64], transforms: &[Transform], fed: &Fed) -> Option<Vec<f64>> {
+        let mut out = vec![0.0; fed.kin.len()];
+        self.runs.run_into(transforms, theta, &mut out, |out| self.sim.run(theta, &fed.kin, out)).then_some(out)
     }
 
     /// The recorded input through `transforms`.
@@ -434,12 +467,37 @@ impl<'a> Problem<'a> {
         iterations: usize,
     ) -> Option<(Fitted, f64)> {
         let aug = AugSim { prob: self, transforms, terms, tune, cache: std::sync::Mutex::new(Vec::new()) };
+        let p = self.solve(&aug, theta, iterations);
+        let (m, beta, pred, mse, transforms, terms) = aug.full(&p)?;
+        let g = p.get(self.sim.n_params()).copied().unwrap_or(0.0);
+        let theta = p.get(..self.sim.n_params())?.to_vec();
+        Some((Fitted { transforms, terms, theta, beta, model: m, pred, train_mse: mse }, g))
+    }
+
+    /// [`Problem::refit`] without a candidate's value, for its θ and training MSE only: the
+    /// base model is run up to the last training row, not over the whole recording (a
+    /// profile's refit on the first seconds of a long one). The same θ and MSE to the bit.
+    pub fn refit_train(
+        &self,
+        transforms: &[Transform],
+        terms: &[Term],
+        theta: &[f64],
+        iterations: usize,
+    ) -> Option<(Vec<f64>, f64)> {
+        let aug = AugSim { prob: self, transforms, terms, tune: None, cache: std::sync::Mutex::new(Vec::new()) };
+        let p = self.solve(&aug, theta, iterations);
+        let mse = aug.train_mse(&p)?;
+        Some((p, mse))
+    }
+
+    /// The parameters `aug`'s refit ends at (see [`Problem::refit`]).
+    fn solve(&self, aug: &AugSim<'_, '_>, theta: &[f64], iterations: usize) -> Vec<f64> {
         let mut spec = self.spec.clone();
         // A fitted value outside the refits' box (a parameter held ≥ 0 after the fit) starts
         // inside it: from outside, the box's end would stick and the start win unchanged.
         let mut start: Vec<f64> =
             theta.iter().enumerate().map(|(j, v)| spec.params.get(j).map_or(*v, |p| p.into_box(*v))).collect();
-        if let Some(t) = tune {
+        if let Some(t) = aug.tune {
             let (lo, hi) = (t.lo.min(t.hi), t.hi.max(t.lo));
             spec.params.push(crate::models::search::ParamSpec {
                 name: "candidate",
@@ -451,30 +509,24 @@ impl<'a> Problem<'a> {
             });
             start.push(t.start.clamp(lo, hi));
         }
-        let p = if iterations == 0 {
-            start
-        } else {
-            // AugSim makes its own kinematics (through the transforms): the objective's are
-            // read only for their length.
-            let kin = vec![model_core::Kin::default(); self.data.len()];
-            let scale = {
-                let ys: Vec<f64> = self.train.iter().filter_map(|&i| self.data.output.get(i).copied()).collect();
-                let m = ys.iter().sum::<f64>() / ys.len().max(1) as f64;
-                (ys.iter().map(|v| (v - m).powi(2)).sum::<f64>() / ys.len().max(1) as f64).sqrt()
-            };
-            let obj =
-                crate::ident::fit::objective::Objective::new(&aug, &spec, &kin, &self.data.output, &self.train, scale);
-            let r = crate::ident::fit::lm::minimize_reduced(&obj, &start, iterations);
-            if r.cost.is_finite() && r.cost <= obj.cost(&start) {
-                r.params
-            } else {
-                start
-            }
+        if iterations == 0 {
+            return start;
+        }
+        // AugSim makes its own kinematics (through the transforms): the objective's are
+        // read only for their length.
+        let kin = vec![model_core::Kin::default(); self.data.len()];
+        let scale = {
+            let ys: Vec<f64> = self.train.iter().filter_map(|&i| self.data.output.get(i).copied()).collect();
+            let m = ys.iter().sum::<f64>() / ys.len().max(1) as f64;
+            (ys.iter().map(|v| (v - m).powi(2)).sum::<f64>() / ys.len().max(1) as f64).sqrt()
         };
-        let (m, beta, pred, mse, transforms, terms) = aug.full(&p)?;
-        let g = p.get(self.sim.n_params()).copied().unwrap_or(0.0);
-        let theta = p.get(..self.sim.n_params())?.to_vec();
-        Some((Fitted { transforms, terms, theta, beta, model: m, pred, train_mse: mse }, g))
+        let obj = crate::ident::fit::objective::Objective::new(aug, &spec, &kin, &self.data.output, &self.train, scale);
+        let r = crate::ident::fit::lm::minimize_reduced(&obj, &start, iterations);
+        if r.cost.is_finite() && r.cost <= obj.cost(&start) {
+            r.params
+        } else {
+            start
+        }
     }
 
     /// Training MSE of `transforms` + `terms` linearised about `theta`: the base model's
@@ -482,7 +534,7 @@ impl<'a> Problem<'a> {
     /// run of the base model, for scanning a candidate's grid cheaply.
     pub fn scan_cost(&self, transforms: &[Transform], terms: &[Term], theta: &[f64], jac: &[Vec<f64>]) -> Option<f64> {
         let fed = self.fed(transforms)?;
-        let m = self.run_kin(theta, &fed.kin)?;
+        let m = self.run_fed(theta, transforms, &fed)?;
         let terms = self.through(terms.to_vec(), transforms, &fed.x);
         let term_cols: Vec<std::borrow::Cow<'_, [f64]>> = terms.iter().map(|t| t.column(&m)).collect();
         let cols: Vec<&[f64]> = jac.iter().map(Vec::as_slice).chain(term_cols.iter().map(|c| &**c)).collect();
@@ -493,41 +545,10 @@ impl<'a> Problem<'a> {
     /// The base model's Jacobian at `theta` through `transforms`.
     pub fn jacobian_at(&self, theta: &[f64], transforms: &[Transform]) -> Option<Vec<Vec<f64>>> {
         let fed = self.fed(transforms)?;
-        let m0 = self.run_kin(theta, &fed.kin)?;
+        let m0 = self.run_fed(theta, transforms, &fed)?;
         Some(self.jacobian(theta, &fed.kin, &m0))
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::super::play::play;
-    use super::*;
-
-    #[test]
-    fn a_map_of_the_input_is_made_again_from_the_input_through_the_transforms_it_follows() {
-        let x: Vec<f64> = (0..300).map(|i| 0.8 * (i as f64 * 0.03).sin()).collect();
-        use rand::SeedableRng;
-        let rng = &mut rand::rngs::StdRng::seed_from_u64(1);
-        let data = crate::ident::diagnose::tests::with_noise(x.clone(), &vec![0.0; x.len()], rng);
-        let spec = crate::models::host("algebraic").and_then(|h| h.spec(&data.scales(), None)).unwrap();
-        let sim = crate::ident::fit::simulate::simulator("algebraic", 1e-3).unwrap();
-        let prob = Problem::new(&data, (sim.as_ref(), &spec), spec.rate, vec![], 50.0);
-        let (sat, lag) = (Transform::Saturate { b_sat: 0.4 }, Transform::Lag { tau_s: 0.02 });
-        let both = [sat.clone(), lag.clone()];
-        let seen = prob.transformed(&both);
-        let lagged = lag.apply(&x, 1e-3);
-        let level = InputMap::LevelPower { x_ref: 0.8, p: 1.5 };
-        let terms = vec![
-            Term::of_input("play", InputMap::Play { radius: 0.1 }, &x),
-            Term::of_input("level", level, &x),
-            Term::additive("fixed", x.clone()),
-        ];
-        let after = prob.through(terms, &both, &seen);
-        // The plays follow both; the level term the lag only; the plain term neither.
-        assert_eq!(after[0].values, play(&seen, 0.1));
-        assert_ne!(after[0].values, play(&x, 0.1));
-        assert_eq!(after[1].values, level.values(&lagged));
-        assert!((after[1].values[52] - 0.8 * (lagged[52] / 0.8).powf(1.5)).abs() < 1e-12);
-        assert_eq!(after[2].values, x);
-    }
-}
+mod tests;

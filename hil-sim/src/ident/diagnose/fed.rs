@@ -32,11 +32,11 @@ pub struct Fed {
 pub struct Feeds(Mutex<Vec<(Key, Arc<Fed>)>>);
 
 /// A chain of transforms as bits ([`key`]).
-type Key = Vec<(u8, u64)>;
+pub(super) type Key = Vec<(u8, u64)>;
 
 /// A chain as bits: the kind of each transform and its value's bits (so `0.0` and `-0.0`,
 /// which some transforms may treat alike, are still two chains).
-fn key(chain: &[Transform]) -> Key {
+pub(super) fn key(chain: &[Transform]) -> Key {
     chain
         .iter()
         .map(|t| match *t {

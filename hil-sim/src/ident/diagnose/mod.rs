@@ -56,6 +56,7 @@ pub mod projection;
 pub mod rank;
 pub mod refit;
 pub mod replicate;
+pub mod runs;
 pub mod scan;
 pub mod significance;
 pub mod transform;

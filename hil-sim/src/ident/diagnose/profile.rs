@@ -34,10 +34,10 @@ pub fn starts(prob: &Problem<'_>, c: &Candidate, current: &Fitted) -> Vec<Start>
             let mut out = Vec::with_capacity(chain.len());
             for &g in chain {
                 let (transforms, terms) = c.on_top(current, g);
-                match prob.refit(&transforms, &terms, None, &theta, PROFILE_ITERATIONS) {
-                    Some((f, _)) => {
-                        out.push((g, f.train_mse, Some(f.theta.clone())));
-                        theta = f.theta;
+                match prob.refit_train(&transforms, &terms, &theta, PROFILE_ITERATIONS) {
+                    Some((fitted, mse)) => {
+                        out.push((g, mse, Some(fitted.clone())));
+                        theta = fitted;
                     }
                     None => out.push((g, f64::INFINITY, None)),
                 }
