@@ -476,7 +476,9 @@ impl<'a> Problem<'a> {
 
     /// [`Problem::refit`] without a candidate's value, for its θ and training MSE only: the
     /// base model is run up to the last training row, not over the whole recording (a
-    /// profile's refit on the first seconds of a long one). The same θ and MSE to the bit.
+    /// profile's refit on the first seconds of a long one). The same θ and MSE to the bit,
+    /// but where the base model diverges only after the last training row: the whole refit
+    /// fails there, this one does not.
     pub fn refit_train(
         &self,
         transforms: &[Transform],
