@@ -265,10 +265,8 @@ impl AugSim<'_, '_> {
         if terms.iter().any(|t| matches!(t.kind, TermKind::OutputSaturation { .. })) {
             return self.full(p).map(|f| f.3);
         }
-        let len = self.prob.train.last().map_or(0, |&i| i + 1);
-        let kin = fed.kin.get(..len)?;
-        let mut m = vec![0.0; len];
-        if !self.prob.runs.run_into(transforms, theta, &mut m, |out| self.prob.sim.run(theta, kin, out)) {
+        let mut m = vec![0.0; self.prob.train.last().map_or(0, |&i| i + 1)];
+        if !self.prob.run_into(theta, transforms, fed, &mut m) {
             return None;
         }
         self.prob.add_terms(terms, projection, &mut m, true).map(|(_, mse)| mse)
@@ -305,9 +303,9 @@ impl Simulator for AugSim<'_, '_> {
         };
         let (fed, transforms, terms, projection) = &*piece;
         // The base model's output, then the terms added to it, in `out` itself.
-        let Some(kin) = fed.kin.get(..out.len()) else { return false };
-        let ran = self.prob.runs.run_into(transforms, theta, out, |out| self.prob.sim.run(theta, kin, out));
-        if !ran || self.prob.add_terms(terms, projection, out, false).is_none() {
+        if !self.prob.run_into(theta, transforms, fed, out)
+            || self.prob.add_terms(terms, projection, out, false).is_none()
+        {
             return false;
         }
         out.iter().all(|v| v.is_finite())
@@ -342,10 +340,16 @@ impl<'a> Problem<'a> {
     }
 
     /// The base model's output for `theta` fed `fed` (the input through `transforms`), over
-    /// the whole recording: kept or run ([`super::runs`]).
+    /// the whole recording (`None` if it diverges).
     fn run_fed(&self, theta: &[f64], transforms: &[Transform], fed: &Fed) -> Option<Vec<f64>> {
         let mut out = vec![0.0; fed.kin.len()];
-        self.runs.run_into(transforms, theta, &mut out, |out| self.sim.run(theta, &fed.kin, out)).then_some(out)
+        self.run_into(theta, transforms, fed, &mut out).then_some(out)
+    }
+
+    /// The same over the first `out.len()` samples, into `out`: kept or run ([`super::runs`]).
+    fn run_into(&self, theta: &[f64], transforms: &[Transform], fed: &Fed, out: &mut [f64]) -> bool {
+        let Some(kin) = fed.kin.get(..out.len()) else { return false };
+        self.runs.run_into(transforms, theta, out, |out| self.sim.run(theta, kin, out))
     }
 
     /// The recorded input through `transforms`.

@@ -35,9 +35,9 @@ pub fn starts(prob: &Problem<'_>, c: &Candidate, current: &Fitted) -> Vec<Start>
             for &g in chain {
                 let (transforms, terms) = c.on_top(current, g);
                 match prob.refit_train(&transforms, &terms, &theta, PROFILE_ITERATIONS) {
-                    Some((fitted, mse)) => {
-                        out.push((g, mse, Some(fitted.clone())));
-                        theta = fitted;
+                    Some((refitted, mse)) => {
+                        out.push((g, mse, Some(refitted.clone())));
+                        theta = refitted;
                     }
                     None => out.push((g, f64::INFINITY, None)),
                 }
