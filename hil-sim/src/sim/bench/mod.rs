@@ -201,6 +201,10 @@ pub enum Set {
     /// host's odd cubic, its weight ≥ 0).
     Fresh56,
     Fresh57,
+    /// The fifty-ninth and sixtieth, first run for the nineteenth report (the screen's refits
+    /// two iterations, the leading candidates' seven).
+    Fresh58,
+    Fresh59,
 }
 
 impl Set {
@@ -266,6 +270,8 @@ impl Set {
         ("fresh55", Set::Fresh55, 832_000_000, 277),
         ("fresh56", Set::Fresh56, 862_000_000, 281),
         ("fresh57", Set::Fresh57, 892_000_000, 283),
+        ("fresh58", Set::Fresh58, 922_000_000, 293),
+        ("fresh59", Set::Fresh59, 952_000_000, 307),
     ];
 
     /// The seed of case `k` of this set.
