@@ -15,14 +15,15 @@ use super::scan::starts_on_grid;
 
 /// Levenberg–Marquardt iterations of every candidate's refit (from each start)…
 ///
-/// Two since 2026-11-30 (three before): the screen's refits were the largest share of a
-/// diagnosis' time, and the [`POLISHED`] leading ones get the rest of the reference's
-/// iterations anyway. On 41 `simulate --effect` recordings every finding stayed the same;
-/// one iteration moved two of them.
-pub const SCREEN_ITERATIONS: usize = 2;
+/// Two (the leading ones seven more) were tried on 2026-11-30 for speed (0.96 of the
+/// instructions): the held-out ranges fresh58 and fresh59 kept their rates, but Spencer's
+/// timing skew on the Dyke recording (`--command Y`) was lost: a delay moves the base's
+/// optimum far, and two iterations left its refit 2,875 BIC worse than the reference, out
+/// of the polished three.
+pub const SCREEN_ITERATIONS: usize = 3;
 /// …and the further ones for the [`POLISHED`] leading candidates; the reference a gain is
 /// judged against gets both (nine).
-pub const POLISH_ITERATIONS: usize = 7;
+pub const POLISH_ITERATIONS: usize = 6;
 pub const POLISHED: usize = 3;
 /// A reference that reconverged lower than the stalled one by more than this (BIC) has its
 /// candidates refitted on top of it ([`rank`]). Most reconvergences are a few units (seven

@@ -202,7 +202,7 @@ pub enum Set {
     Fresh56,
     Fresh57,
     /// The fifty-ninth and sixtieth, first run for the nineteenth report (the screen's refits
-    /// two iterations, the leading candidates' seven).
+    /// two iterations, the leading candidates' seven; taken back for the Dyke timing skew).
     Fresh58,
     Fresh59,
 }
