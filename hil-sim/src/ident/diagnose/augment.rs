@@ -166,6 +166,14 @@ pub struct Problem<'a> {
     feeds: std::sync::Arc<Feeds>,
     /// …and the base model's outputs run last ([`super::runs`]).
     runs: std::sync::Arc<Runs>,
+    /// Standard deviation of the output on the training rows: the refits' cost scale.
+    scale: f64,
+}
+
+/// Standard deviation of `data`'s output on the rows `train`.
+fn spread(data: &Dataset, train: &[usize]) -> f64 {
+    let ys: Vec<f64> = train.iter().filter_map(|&i| data.output.get(i).copied()).collect();
+    crate::numerics::stats::std(&ys)
 }
 
 /// A refitted augmented model.
@@ -323,14 +331,16 @@ impl<'a> Problem<'a> {
         rate_cutoff_hz: f64,
     ) -> Self {
         let (feeds, runs) = Default::default();
-        Problem { data, sim, spec, rate, train, rate_cutoff_hz, feeds, runs }
+        let scale = spread(data, &train);
+        Problem { data, sim, spec, rate, train, rate_cutoff_hz, feeds, runs, scale }
     }
 
     /// The same problem trained on `train` instead (another split of the recording).
     pub fn on_rows(&self, train: Vec<usize>) -> Problem<'a> {
         let (data, sim, spec, rate, rate_cutoff_hz) = (self.data, self.sim, self.spec, self.rate, self.rate_cutoff_hz);
         let (feeds, runs) = (std::sync::Arc::clone(&self.feeds), std::sync::Arc::clone(&self.runs));
-        Problem { data, sim, spec, rate, train, rate_cutoff_hz, feeds, runs }
+        let scale = spread(data, &train);
+        Problem { data, sim, spec, rate, train, rate_cutoff_hz, feeds, runs, scale }
     }
 
     /// The base model's output for `theta` fed the transformed input (`None` if it diverges).
@@ -521,12 +531,8 @@ impl<'a> Problem<'a> {
         // AugSim makes its own kinematics (through the transforms): the objective's are
         // read only for their length.
         let kin = vec![model_core::Kin::default(); self.data.len()];
-        let scale = {
-            let ys: Vec<f64> = self.train.iter().filter_map(|&i| self.data.output.get(i).copied()).collect();
-            let m = ys.iter().sum::<f64>() / ys.len().max(1) as f64;
-            (ys.iter().map(|v| (v - m).powi(2)).sum::<f64>() / ys.len().max(1) as f64).sqrt()
-        };
-        let obj = crate::ident::fit::objective::Objective::new(aug, &spec, &kin, &self.data.output, &self.train, scale);
+        let (y, train) = (&self.data.output, &self.train);
+        let obj = crate::ident::fit::objective::Objective::new(aug, &spec, &kin, y, train, self.scale);
         let r = crate::ident::fit::lm::minimize_reduced(&obj, &start, iterations);
         if r.cost.is_finite() && r.cost <= obj.cost(&start) {
             r.params
