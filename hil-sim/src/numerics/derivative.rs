@@ -101,20 +101,42 @@ pub fn content_frequency(x: &[f64], dt: f64) -> Option<f64> {
 
 /// Central-difference derivative (one-sided at the ends).
 pub fn gradient(v: &[f64], dt: f64) -> Vec<f64> {
-    let n = v.len();
-    (0..n)
-        .map(|i| match (i.checked_sub(1).and_then(|j| v.get(j)), v.get(i + 1)) {
-            (Some(a), Some(b)) => (b - a) / (2.0 * dt),
-            (None, Some(b)) => (b - v[i]) / dt,
-            (Some(a), None) => (v[i] - a) / dt,
-            (None, None) => 0.0,
-        })
-        .collect()
+    let [first, .., last] = v else { return vec![0.0; v.len()] };
+    let (second, before_last) = (v[1], v[v.len() - 2]);
+    let mut out = Vec::with_capacity(v.len());
+    out.push((second - first) / dt);
+    // The inside, as one loop without branches (vectorised).
+    let two_dt = 2.0 * dt;
+    out.extend(v.iter().zip(&v[2..]).map(|(a, b)| (b - a) / two_dt));
+    out.push((last - before_last) / dt);
+    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_gradient_is_central_inside_and_one_sided_at_the_ends() {
+        let dt = 0.37;
+        // Entry by entry, as written before the loop was vectorised.
+        let one_by_one = |v: &[f64]| -> Vec<f64> {
+            (0..v.len())
+                .map(|i| match (i.checked_sub(1).and_then(|j| v.get(j)), v.get(i + 1)) {
+                    (Some(a), Some(b)) => (b - a) / (2.0 * dt),
+                    (None, Some(b)) => (b - v[i]) / dt,
+                    (Some(a), None) => (v[i] - a) / dt,
+                    (None, None) => 0.0,
+                })
+                .collect()
+        };
+        let v: Vec<f64> = (0..41).map(|i| (i as f64 * 0.7).sin() * 3.1 + (i * i) as f64 * 1e-3).collect();
+        for n in 0..v.len() {
+            let got: Vec<u64> = gradient(&v[..n], dt).iter().map(|g| g.to_bits()).collect();
+            let want: Vec<u64> = one_by_one(&v[..n]).iter().map(|g| g.to_bits()).collect();
+            assert_eq!(got, want, "{n} samples");
+        }
+    }
 
     #[test]
     fn the_cutoff_follows_the_content_and_quiets_a_quantised_rate() {

@@ -11,12 +11,7 @@ use nalgebra::{DMatrix, DVector};
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
     let (ra, rb) = (ca.remainder(), cb.remainder());
-    let mut acc = [0.0f64; 8];
-    for (x, y) in ca.zip(cb) {
-        for k in 0..8 {
-            acc[k] += x[k] * y[k];
-        }
-    }
+    let acc = partial_sums([0.0; 8], a, b);
     let mut s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
     for (x, y) in ra.iter().zip(rb) {
         s += x * y;
@@ -24,18 +19,67 @@ pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     s
 }
 
+/// `acc` with the products of `a` and `b` added, eight rows at a time (row `8i + k` into
+/// `acc[k]`), over the whole chunks of eight of the shorter.
+#[inline(always)]
+fn partial_sums(mut acc: [f64; 8], a: &[f64], b: &[f64]) -> [f64; 8] {
+    for (x, y) in a.chunks_exact(8).zip(b.chunks_exact(8)) {
+        for k in 0..8 {
+            acc[k] += x[k] * y[k];
+        }
+    }
+    acc
+}
+
 /// `AᵀA` of the columns `cols` (equal lengths) by their products ([`dot`]), each pair once.
 pub fn gram(cols: &[&[f64]]) -> DMatrix<f64> {
     let k = cols.len();
+    let pairs: Vec<(usize, usize)> = (0..k).flat_map(|a| (a..k).map(move |b| (a, b))).collect();
     let mut g = DMatrix::<f64>::zeros(k, k);
-    for a in 0..k {
-        for b in a..k {
-            let v = dot(cols[a], cols[b]);
-            g[(a, b)] = v;
-            g[(b, a)] = v;
-        }
+    for (&(a, b), v) in pairs.iter().zip(pair_dots(cols, &pairs)) {
+        g[(a, b)] = v;
+        g[(b, a)] = v;
     }
     g
+}
+
+/// Rows per block of [`pair_dots`]: a column's block is 16 KiB, so the blocks of a dozen
+/// columns stay in the core's second-level cache while every pair is summed.
+const BLOCK_ROWS: usize = 2048;
+
+/// [`dot`] of `cols[a]` and `cols[b]` for each `(a, b)` of `pairs`, the same sums to the
+/// bit: each pair's eight partial sums run over the rows in the same order, but block by
+/// block of [`BLOCK_ROWS`], so that each column is read from memory once rather than once
+/// per pair it is in (tens of thousands of rows: the dot products of a Gram matrix were
+/// bound by memory, not arithmetic). Columns of unequal lengths are summed pair by pair.
+pub fn pair_dots(cols: &[&[f64]], pairs: &[(usize, usize)]) -> Vec<f64> {
+    let n = cols.first().map_or(0, |c| c.len());
+    let valid = pairs.iter().all(|&(a, b)| a < cols.len() && b < cols.len());
+    if !valid || cols.iter().any(|c| c.len() != n) {
+        // A pair past the columns is NaN.
+        let one = |&(a, b): &(usize, usize)| cols.get(a).zip(cols.get(b)).map_or(f64::NAN, |(x, y)| dot(x, y));
+        return pairs.iter().map(one).collect();
+    }
+    let whole = n - n % 8;
+    let mut acc = vec![[0.0f64; 8]; pairs.len()];
+    let mut lo = 0;
+    while lo < whole {
+        let hi = (lo + BLOCK_ROWS).min(whole);
+        for (acc, &(a, b)) in acc.iter_mut().zip(pairs) {
+            *acc = partial_sums(*acc, &cols[a][lo..hi], &cols[b][lo..hi]);
+        }
+        lo = hi;
+    }
+    acc.iter()
+        .zip(pairs)
+        .map(|(acc, &(a, b))| {
+            let mut s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
+            for (x, y) in cols[a][whole..].iter().zip(&cols[b][whole..]) {
+                s += x * y;
+            }
+            s
+        })
+        .collect()
 }
 
 /// Add one row `a` with target `b` to the lower triangle of `gram` and to `atb`.
@@ -158,6 +202,26 @@ pub fn solve_cholesky(g: DMatrix<f64>, b: &DVector<f64>, svd_eps: f64) -> Option
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn dots_in_blocks_are_the_dots_to_the_bit() {
+        let col = |n: usize, f: f64| -> Vec<f64> { (0..n).map(|i| (i as f64 * f).sin() * (1.0 + i as f64)).collect() };
+        for n in [0, 5, 8, 13, BLOCK_ROWS, BLOCK_ROWS + 3, 3 * BLOCK_ROWS + 17] {
+            let cols: Vec<Vec<f64>> = (0..4).map(|k| col(n, 0.1 + 0.37 * k as f64)).collect();
+            let refs: Vec<&[f64]> = cols.iter().map(Vec::as_slice).collect();
+            let pairs = [(0, 0), (0, 3), (2, 1), (3, 3), (1, 2)];
+            let got: Vec<u64> = pair_dots(&refs, &pairs).iter().map(|v| v.to_bits()).collect();
+            let want: Vec<u64> = pairs.iter().map(|&(a, b)| dot(refs[a], refs[b]).to_bits()).collect();
+            assert_eq!(got, want, "{n} rows");
+            let g = gram(&refs);
+            assert!(pairs.iter().all(|&(a, b)| g[(a, b)] == dot(refs[a], refs[b]) && g[(b, a)] == g[(a, b)]));
+        }
+        // Unequal lengths: pair by pair, as `dot` pairs them; a pair past the columns is NaN.
+        let (a, b) = (col(3000, 0.2), col(2100, 0.3));
+        let got = pair_dots(&[&a, &b], &[(0, 1), (1, 1), (0, 2)]);
+        assert_eq!(got[..2], [dot(&a, &b), dot(&b, &b)]);
+        assert!(got[2].is_nan());
+    }
 
     #[test]
     fn fit_rows_recovers_a_line() {

@@ -8,6 +8,7 @@ pub mod metrics;
 pub mod nnls;
 pub mod number;
 pub mod reduce;
+pub mod spans;
 pub mod stats;
 pub mod units;
 

@@ -25,7 +25,7 @@ use super::fed::{Fed, Feeds};
 use super::projection::{self, Projection};
 use super::runs::Runs;
 use super::transform::Transform;
-use crate::ident::fit::simulate::{kinematics, Simulator};
+use crate::ident::fit::simulate::{kinematics, kinematics_given, Simulator};
 use crate::ident::fit::Dataset;
 use crate::models::search::{ModelSpec, Spacing};
 use crate::models::RateSpec;
@@ -117,6 +117,10 @@ impl Term {
     pub fn output_saturation(name: impl Into<String>, t_sat: f64) -> Self {
         Self { name: name.into(), values: Vec::new(), kind: TermKind::OutputSaturation { t_sat }, of_input: None }
     }
+    /// The radius of its play operator, when it is one of the input.
+    pub fn play_radius(&self) -> Option<f64> {
+        self.of_input.as_ref().and_then(|(m, _)| if let InputMap::Play { radius } = m { Some(*radius) } else { None })
+    }
     /// Whether its column is its values, the same whatever the base model predicts.
     pub fn is_additive(&self) -> bool {
         matches!(self.kind, TermKind::Additive)
@@ -162,7 +166,8 @@ pub struct Problem<'a> {
     /// Cutoff (Hz) of the zero-phase rate of the given rates
     /// ([`crate::numerics::derivative::content_cutoff`]): a transformed input gets its rate the same way.
     pub rate_cutoff_hz: f64,
-    /// The feeds made so far ([`super::fed`]), shared with [`Problem::on_rows`]'s problems…
+    /// The feeds made so far ([`super::fed`]), shared with [`Problem::on_rows`]'s problems
+    /// (and [`Problem::sharing`]'s)…
     feeds: std::sync::Arc<Feeds>,
     /// …and the base model's outputs run last ([`super::runs`]).
     runs: std::sync::Arc<Runs>,
@@ -335,6 +340,12 @@ impl<'a> Problem<'a> {
         Problem { data, sim, spec, rate, train, rate_cutoff_hz, feeds, runs, scale }
     }
 
+    /// The same problem with the feeds of `feeds` ([`super::fed`]): those of other problems
+    /// on the same recording and rate cutoff (another base model's).
+    pub fn sharing(self, feeds: &std::sync::Arc<Feeds>) -> Self {
+        Problem { feeds: std::sync::Arc::clone(feeds), ..self }
+    }
+
     /// The same problem trained on `train` instead (another split of the recording).
     pub fn on_rows(&self, train: Vec<usize>) -> Problem<'a> {
         let (data, sim, spec, rate, rate_cutoff_hz) = (self.data, self.sim, self.spec, self.rate, self.rate_cutoff_hz);
@@ -364,8 +375,9 @@ impl<'a> Problem<'a> {
 
     /// The recorded input through `transforms`.
     pub(super) fn transformed(&self, transforms: &[Transform]) -> Vec<f64> {
-        let mut x = self.data.input.clone();
-        for t in transforms {
+        let Some((first, rest)) = transforms.split_first() else { return self.data.input.clone() };
+        let mut x = first.apply(&self.data.input, self.data.dt);
+        for t in rest {
             x = t.apply(&x, self.data.dt);
         }
         x
@@ -374,8 +386,20 @@ impl<'a> Problem<'a> {
     /// `terms` with the maps of the input made again from the recorded input through the
     /// `transforms` each follows ([`InputMap::follows`]; `x`: through all of them).
     pub(super) fn through(&self, mut terms: Vec<Term>, transforms: &[Transform], x: &[f64]) -> Vec<Term> {
+        if !transforms.is_empty() {
+            // The play operators follow every transform: made side by side, in one pass.
+            let radii: Vec<f64> = terms.iter().filter_map(Term::play_radius).collect();
+            let mut made = super::play::plays(x, &radii).into_iter();
+            terms
+                .iter_mut()
+                .filter(|t| t.play_radius().is_some())
+                .for_each(|t| t.values = made.next().unwrap_or_default());
+        }
         for t in &mut terms {
             let Some((map, recorded)) = &t.of_input else { continue };
+            if matches!(map, InputMap::Play { .. }) && !transforms.is_empty() {
+                continue;
+            }
             t.values = if !transforms.iter().any(|tr| map.follows(tr)) {
                 recorded.as_ref().clone()
             } else if transforms.iter().all(|tr| map.follows(tr)) {
@@ -390,7 +414,15 @@ impl<'a> Problem<'a> {
 
     /// The recorded input through `transforms` and its kinematics, made once ([`super::fed`]).
     pub(super) fn fed(&self, transforms: &[Transform]) -> Option<std::sync::Arc<Fed>> {
-        self.feeds.get_or_make(transforms, || {
+        // Given rates make the kinematics whatever the estimator, once it can be built.
+        let rates = match self.data.rates {
+            Some(_) => {
+                self.rate.build(self.data.dt as f32).ok()?;
+                None
+            }
+            None => super::fed::rates(self.rate),
+        };
+        self.feeds.get_or_make(rates, transforms, || {
             let x = self.transformed(transforms);
             let kin = self.kin_of(&x)?;
             Some(Fed { x, kin })
@@ -400,13 +432,12 @@ impl<'a> Problem<'a> {
     /// The base model's kinematics for the (transformed) input `x`.
     pub(super) fn kin_of(&self, x: &[f64]) -> Option<Vec<model_core::Kin>> {
         // Given rates are the zero-phase ones: recomputed for the transformed input.
-        let rates = self
-            .data
-            .rates
-            .as_ref()
-            .map(|_| crate::numerics::derivative::rates_below(x, self.data.dt, self.rate_cutoff_hz));
-        let samples = crate::models::replay::samples_with_rates(x, self.data.command.as_deref(), rates.as_ref());
-        kinematics(&samples, self.data.dt as f32, self.rate)
+        let (dt, u) = (self.data.dt as f32, self.data.command.as_deref());
+        if self.data.rates.is_none() {
+            return kinematics(&crate::models::replay::samples(x, u), dt, self.rate);
+        }
+        let (dx, ddx) = crate::numerics::derivative::rates_below(x, self.data.dt, self.rate_cutoff_hz);
+        kinematics_given(x, u, &dx, &ddx, dt, self.rate)
     }
 
     pub(super) fn run_kin(&self, theta: &[f64], kin: &[model_core::Kin]) -> Option<Vec<f64>> {

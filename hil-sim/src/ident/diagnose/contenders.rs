@@ -84,13 +84,16 @@ pub struct Shared<'a, 'b> {
     pub aux: &'b [(&'b str, &'b [f64])],
     /// Cutoff (Hz) of the input's zero-phase rate.
     pub rate_cutoff_hz: f64,
+    /// The feeds of the base models ([`super::fed`]), made once for every contender.
+    pub feeds: std::sync::Arc<super::fed::Feeds>,
 }
 
 /// The first round on `base`, with play operators when `with_plays`.
 pub fn open<'a>(base: &'a Base, s: &Shared<'a, '_>, with_plays: bool) -> Result<Opening<'a>, DiagnoseError> {
     let diverges = || DiagnoseError::Diverges(base.fit.model.clone());
     let prob =
-        Problem::new(s.data, (base.sim.as_ref(), &base.spec), base.fit.rate_choice, s.train.to_vec(), s.rate_cutoff_hz);
+        Problem::new(s.data, (base.sim.as_ref(), &base.spec), base.fit.rate_choice, s.train.to_vec(), s.rate_cutoff_hz)
+            .sharing(&s.feeds);
     // Run on from the fit until it stalls, so that a term is never credited with what more
     // iterations of the base would have done.
     let terms = if with_plays { plays(&s.data.input) } else { Vec::new() };

@@ -147,6 +147,7 @@ fn diagnose_at_rate(
         rate: &dx,
         aux: &aux_refs,
         rate_cutoff_hz,
+        feeds: Default::default(),
     };
     let mut openings = contenders::open_all(&fitted, &shared)?;
     let chosen = contenders::choose(&openings, &judge0);

@@ -10,6 +10,7 @@
 //! the same, in the same order, as solving from scratch ([`lsq`]).
 
 use crate::numerics::lstsq::{self, dot};
+use crate::numerics::spans::Spans;
 
 /// A column on the rows, scaled to unit norm, and the norm it was divided by.
 struct Scaled {
@@ -19,22 +20,17 @@ struct Scaled {
 
 impl Scaled {
     /// `None` when the column is shorter than the last row.
-    fn new(column: &[f64], rows: &[usize]) -> Option<Self> {
-        let v = gather(column, rows)?;
+    fn new(column: &[f64], rows: &Spans) -> Option<Self> {
+        let v = rows.gather(column)?;
         let s = dot(&v, &v).sqrt();
         let norm = if s > 0.0 && s.is_finite() { s } else { 1.0 };
         Some(Self { values: v.into_iter().map(|x| x / norm).collect(), norm })
     }
 }
 
-/// `values` on `rows`; `None` when a row is past its end.
-fn gather(values: &[f64], rows: &[usize]) -> Option<Vec<f64>> {
-    crate::numerics::on_rows(rows, |i| values.get(i).copied())
-}
-
 /// `output − model` on `rows`; `None` when a row is past the end of either.
-fn difference(output: &[f64], model: &[f64], rows: &[usize]) -> Option<Vec<f64>> {
-    crate::numerics::on_rows(rows, |i| Some(output.get(i)? - model.get(i)?))
+fn difference(output: &[f64], model: &[f64], rows: &Spans) -> Option<Vec<f64>> {
+    rows.map2(output, model, |o, m| o - m)
 }
 
 /// A column of a [`Projection`].
@@ -49,7 +45,7 @@ enum Fixed {
 
 /// Least squares on fixed rows whose fixed columns are prepared once.
 pub struct Projection {
-    rows: Vec<usize>,
+    rows: Spans,
     /// One entry per column.
     fixed: Vec<Fixed>,
     /// Products of the fixed columns' pairs (row-major, `k × k`; `None` where either varies).
@@ -63,23 +59,33 @@ impl Projection {
     /// row, like the target), `None` for one given to every solve. A fixed column shorter
     /// than the last row is kept as missing: every solve then fails.
     pub fn new(columns: &[Option<&[f64]>], rows: &[usize]) -> Self {
+        let rows = Spans::of(rows);
         let fixed: Vec<Fixed> = columns
             .iter()
             .map(|c| match c {
-                Some(c) => Scaled::new(c, rows).map_or(Fixed::Short, Fixed::Prepared),
+                Some(c) => Scaled::new(c, &rows).map_or(Fixed::Short, Fixed::Prepared),
                 None => Fixed::Given,
             })
             .collect();
         let k = fixed.len();
+        // The products of the prepared columns' pairs, in one pass over the rows.
+        let prepared: Vec<(usize, &[f64])> = fixed
+            .iter()
+            .enumerate()
+            .filter_map(|(a, f)| match f {
+                Fixed::Prepared(x) => Some((a, x.values.as_slice())),
+                _ => None,
+            })
+            .collect();
+        let cols: Vec<&[f64]> = prepared.iter().map(|p| p.1).collect();
+        let pairs: Vec<(usize, usize)> = (0..cols.len()).flat_map(|i| (i..cols.len()).map(move |j| (i, j))).collect();
         let mut products = vec![None; k * k];
-        for a in 0..k {
-            for b in a..k {
-                if let (Fixed::Prepared(x), Fixed::Prepared(y)) = (&fixed[a], &fixed[b]) {
-                    products[a * k + b] = Some(dot(&x.values, &y.values));
-                }
+        for (&(i, j), v) in pairs.iter().zip(lstsq::pair_dots(&cols, &pairs)) {
+            if let (Some(a), Some(b)) = (prepared.get(i), prepared.get(j)) {
+                products[a.0 * k + b.0] = Some(v);
             }
         }
-        Self { rows: rows.to_vec(), fixed, products, at_least_zero: Vec::new() }
+        Self { rows, fixed, products, at_least_zero: Vec::new() }
     }
 
     /// The same, with the coefficients of the columns marked `true` held ≥ 0: a column whose
@@ -120,11 +126,30 @@ impl Projection {
                 _ => m.as_ref(),
             })
             .collect();
-        // The normal equations from column products (prepared where both are fixed), ridged.
+        // The normal equations from column products (prepared where both are fixed), ridged;
+        // the others and the right-hand side in one pass over the rows.
+        let mut with_t: Vec<&[f64]> = cols.iter().map(|c| c.values.as_slice()).collect();
+        with_t.push(&t);
+        let pairs: Vec<(usize, usize)> = (0..k)
+            .flat_map(|a| (a..k).map(move |b| (a, b)))
+            .filter(|&(a, b)| self.products[a * k + b].is_none())
+            .chain((0..k).map(|a| (a, k)))
+            .collect();
+        let dots = lstsq::pair_dots(&with_t, &pairs);
         let mut g = nalgebra::DMatrix::<f64>::zeros(k, k);
+        let mut rhs = nalgebra::DVector::<f64>::zeros(k);
         for a in 0..k {
             for b in a..k {
-                let v = self.products[a * k + b].unwrap_or_else(|| dot(&cols[a].values, &cols[b].values));
+                if let Some(v) = self.products[a * k + b] {
+                    g[(a, b)] = v;
+                    g[(b, a)] = v;
+                }
+            }
+        }
+        for (&(a, b), v) in pairs.iter().zip(dots) {
+            if b == k {
+                rhs[a] = v;
+            } else {
                 g[(a, b)] = v;
                 g[(b, a)] = v;
             }
@@ -132,7 +157,6 @@ impl Projection {
         for a in 0..k {
             g[(a, a)] += 1e-10;
         }
-        let rhs = nalgebra::DVector::<f64>::from_fn(k, |a, _| dot(&cols[a].values, &t));
         let sol = self.solve_held(g, rhs)?;
         let coef: Vec<f64> = sol.iter().zip(&cols).map(|(v, c)| v / c.norm).collect();
         if coef.iter().any(|v| !v.is_finite()) {
@@ -178,7 +202,7 @@ impl Projection {
 
     /// Coefficients and the mean squared residual on the rows.
     pub fn fit(&self, varying: &[&[f64]], target: &[f64]) -> Option<(Vec<f64>, f64)> {
-        self.solve_on_rows(varying, gather(target, &self.rows)?, true)
+        self.solve_on_rows(varying, self.rows.gather(target)?, true)
     }
 
     /// Coefficients only (no residual), for `output − model` gathered on the rows from the

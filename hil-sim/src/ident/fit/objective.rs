@@ -32,6 +32,8 @@ pub struct Objective<'a> {
     pub end: usize,
     pub y: &'a [f64],
     pub rows: &'a [usize],
+    /// `rows` as runs ([`crate::numerics::spans`]).
+    spans: crate::numerics::spans::Spans,
     pub scale: f64,
     /// Indices of the free parameters.
     pub free: Vec<usize>,
@@ -58,6 +60,7 @@ impl<'a> Objective<'a> {
             end,
             y,
             rows,
+            spans: crate::numerics::spans::Spans::of(rows),
             scale: scale.max(1e-300),
             free: spec.free(),
             shifted: Mutex::new(Vec::new()),
@@ -127,7 +130,7 @@ impl<'a> Objective<'a> {
     /// Scaled residuals at `p`, `None` when the model rejects `p` or diverges.
     pub fn residuals(&self, p: &[f64]) -> Option<Vec<f64>> {
         let inv = 1.0 / self.scale;
-        self.simulate(p, |out| crate::numerics::on_rows(self.rows, |i| Some((out.get(i)? - self.y.get(i)?) * inv)))
+        self.simulate(p, |out| self.spans.map2(out, self.y, |o, y| (o - y) * inv))
     }
 
     /// The kinematics shifted by `(d, d_u)` samples, from the cache when the delays are

@@ -126,10 +126,61 @@ pub fn kinematics_runs(samples: &[Sample], dt: f32, rate: RateSpec, starts: &[us
     Some(out)
 }
 
+/// [`kinematics`] of the samples [`crate::models::replay::samples_with_rates`] makes of the
+/// input `x`, the command `u` and rates of `x`'s length, without making them: every sample
+/// carries both rates, so the estimator's are unused (it is still built, as there). The
+/// same values to the bit; `None` where [`kinematics`] gives `None`.
+pub fn kinematics_given(
+    x: &[f64],
+    u: Option<&[f64]>,
+    dx: &[f64],
+    ddx: &[f64],
+    dt: f32,
+    rate: RateSpec,
+) -> Option<Vec<Kin>> {
+    rate.build(dt).ok()?;
+    if dx.len() != x.len() || ddx.len() != x.len() {
+        let rates = (dx.to_vec(), ddx.to_vec());
+        return kinematics(&crate::models::replay::samples_with_rates(x, u, Some(&rates)), dt, rate);
+    }
+    let mut out = Vec::with_capacity(x.len());
+    for (i, ((x, dx), ddx)) in x.iter().zip(dx).zip(ddx).enumerate() {
+        let u = u.and_then(|u| u.get(i)).map_or(0.0, |u| *u as f32);
+        let k = Kin { x: *x as f32, dx: *dx as f32, ddx: *ddx as f32, u };
+        if !k.is_finite() {
+            return None;
+        }
+        out.push(k);
+    }
+    Some(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::models::replay;
+
+    #[test]
+    fn given_rates_make_the_kinematics_of_their_samples_to_the_bit() {
+        let x: Vec<f64> = (0..300).map(|i| (i as f64 * 0.031).sin() * 1.7 + 1e-9 * i as f64).collect();
+        let (dx, ddx) = crate::numerics::derivative::rates(&x, 1e-3);
+        let u: Vec<f64> = (0..250).map(|i| 0.01 * i as f64).collect();
+        let rates = (dx.clone(), ddx.clone());
+        for rate in [RateSpec::Backward, RateSpec::Kalman { q: 1e6, r: 1e-6 }] {
+            for u in [None, Some(u.as_slice())] {
+                let made = kinematics(&replay::samples_with_rates(&x, u, Some(&rates)), 1e-3, rate);
+                assert_eq!(kinematics_given(&x, u, &dx, &ddx, 1e-3, rate), made);
+                // Rates shorter than the input: the estimator runs on where they end.
+                let short = (dx[..200].to_vec(), ddx[..200].to_vec());
+                let made = kinematics(&replay::samples_with_rates(&x, u, Some(&short)), 1e-3, rate);
+                assert_eq!(kinematics_given(&x, u, &short.0, &short.1, 1e-3, rate), made);
+            }
+        }
+        let mut bad = x.clone();
+        bad[7] = f64::NAN;
+        assert_eq!(kinematics_given(&bad, None, &dx, &ddx, 1e-3, RateSpec::Backward), None);
+        assert_eq!(kinematics_given(&x, None, &dx, &ddx, 0.0, RateSpec::Backward), None);
+    }
 
     #[test]
     fn given_rates_win_and_the_estimator_runs_on_for_the_samples_without() {

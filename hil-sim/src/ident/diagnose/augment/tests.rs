@@ -22,10 +22,11 @@ fn a_map_of_the_input_is_made_again_from_the_input_through_the_transforms_it_fol
         Term::of_input("play", InputMap::Play { radius: 0.1 }, &x),
         Term::of_input("level", level, &x),
         Term::additive("fixed", x.clone()),
+        Term::of_input("play", InputMap::Play { radius: 0.03 }, &x),
     ];
     let after = prob.through(terms, &both, &seen);
-    // The plays follow both; the level term the lag only; the plain term neither.
-    assert_eq!(after[0].values, play(&seen, 0.1));
+    // The plays follow both (each its own); the level term the lag only; the plain term neither.
+    assert_eq!((&after[0].values, &after[3].values), (&play(&seen, 0.1), &play(&seen, 0.03)));
     assert_ne!(after[0].values, play(&x, 0.1));
     assert_eq!(after[1].values, level.values(&lagged));
     assert!((after[1].values[52] - 0.8 * (lagged[52] / 0.8).powf(1.5)).abs() < 1e-12);
