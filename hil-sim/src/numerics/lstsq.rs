@@ -11,7 +11,13 @@ use nalgebra::{DMatrix, DVector};
 pub fn dot(a: &[f64], b: &[f64]) -> f64 {
     let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
     let (ra, rb) = (ca.remainder(), cb.remainder());
-    let acc = partial_sums([0.0; 8], a, b);
+    finished(partial_sums([0.0; 8], a, b), ra, rb)
+}
+
+/// The eight partial sums `acc` added in a fixed order, then the products of the rows past
+/// the whole chunks (`ra`, `rb`) one by one.
+#[inline(always)]
+fn finished(acc: [f64; 8], ra: &[f64], rb: &[f64]) -> f64 {
     let mut s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
     for (x, y) in ra.iter().zip(rb) {
         s += x * y;
@@ -70,16 +76,7 @@ pub fn pair_dots(cols: &[&[f64]], pairs: &[(usize, usize)]) -> Vec<f64> {
         }
         lo = hi;
     }
-    acc.iter()
-        .zip(pairs)
-        .map(|(acc, &(a, b))| {
-            let mut s = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + ((acc[4] + acc[5]) + (acc[6] + acc[7]));
-            for (x, y) in cols[a][whole..].iter().zip(&cols[b][whole..]) {
-                s += x * y;
-            }
-            s
-        })
-        .collect()
+    acc.iter().zip(pairs).map(|(acc, &(a, b))| finished(*acc, &cols[a][whole..], &cols[b][whole..])).collect()
 }
 
 /// Add one row `a` with target `b` to the lower triangle of `gram` and to `atb`.

@@ -68,21 +68,20 @@ impl Projection {
             })
             .collect();
         let k = fixed.len();
-        // The products of the prepared columns' pairs, in one pass over the rows.
-        let prepared: Vec<(usize, &[f64])> = fixed
+        // The products of the prepared columns' pairs: their Gram matrix.
+        let (at, cols): (Vec<usize>, Vec<&[f64]>) = fixed
             .iter()
             .enumerate()
             .filter_map(|(a, f)| match f {
                 Fixed::Prepared(x) => Some((a, x.values.as_slice())),
                 _ => None,
             })
-            .collect();
-        let cols: Vec<&[f64]> = prepared.iter().map(|p| p.1).collect();
-        let pairs: Vec<(usize, usize)> = (0..cols.len()).flat_map(|i| (i..cols.len()).map(move |j| (i, j))).collect();
+            .unzip();
+        let g = lstsq::gram(&cols);
         let mut products = vec![None; k * k];
-        for (&(i, j), v) in pairs.iter().zip(lstsq::pair_dots(&cols, &pairs)) {
-            if let (Some(a), Some(b)) = (prepared.get(i), prepared.get(j)) {
-                products[a.0 * k + b.0] = Some(v);
+        for (i, &a) in at.iter().enumerate() {
+            for (j, &b) in at.iter().enumerate().skip(i) {
+                products[a * k + b] = Some(g[(i, j)]);
             }
         }
         Self { rows, fixed, products, at_least_zero: Vec::new() }
