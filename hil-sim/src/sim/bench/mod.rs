@@ -205,6 +205,9 @@ pub enum Set {
     /// two iterations, the leading candidates' seven; taken back for the Dyke timing skew).
     Fresh58,
     Fresh59,
+    /// The sixty-first, first run for the closing report of issue 20 (the eighteenth report's
+    /// method, the host tools compiled for the CPU that builds them).
+    Fresh60,
 }
 
 impl Set {
@@ -272,6 +275,7 @@ impl Set {
         ("fresh57", Set::Fresh57, 892_000_000, 283),
         ("fresh58", Set::Fresh58, 922_000_000, 293),
         ("fresh59", Set::Fresh59, 952_000_000, 307),
+        ("fresh60", Set::Fresh60, 1_000_000_000, 311),
     ];
 
     /// The seed of case `k` of this set.
