@@ -37,10 +37,15 @@ fn partial_sums(mut acc: [f64; 8], a: &[f64], b: &[f64]) -> [f64; 8] {
     acc
 }
 
+/// The pairs `(a, b)` with `a ≤ b < k`: the upper triangle of a `k × k` matrix, row by row.
+pub fn upper_pairs(k: usize) -> impl Iterator<Item = (usize, usize)> {
+    (0..k).flat_map(move |a| (a..k).map(move |b| (a, b)))
+}
+
 /// `AᵀA` of the columns `cols` (equal lengths) by their products ([`dot`]), each pair once.
 pub fn gram(cols: &[&[f64]]) -> DMatrix<f64> {
     let k = cols.len();
-    let pairs: Vec<(usize, usize)> = (0..k).flat_map(|a| (a..k).map(move |b| (a, b))).collect();
+    let pairs: Vec<(usize, usize)> = upper_pairs(k).collect();
     let mut g = DMatrix::<f64>::zeros(k, k);
     for (&(a, b), v) in pairs.iter().zip(pair_dots(cols, &pairs)) {
         g[(a, b)] = v;

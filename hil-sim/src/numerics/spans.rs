@@ -1,8 +1,8 @@
 //! Rows (sample indices) as runs of consecutive indices, so that what is read on them is
-//! read slice by slice, in loops the compiler vectorises, rather than index by index
-//! ([`super::on_rows`]). A refit's training rows are a few such runs (the recording's
-//! training part less its flagged samples), and every run of the model gathers tens of
-//! thousands of them: index by index that was a tenth of the work of `diagnose`.
+//! read slice by slice, in loops the compiler vectorises, rather than index by index. A
+//! refit's training rows are a few such runs (the recording's training part less its
+//! flagged samples), and every run of the model gathers tens of thousands of them: index
+//! by index that was a tenth of the work of `diagnose`.
 
 use std::ops::Range;
 
@@ -76,9 +76,9 @@ mod tests {
         for rows in &cases {
             let s = Spans::of(rows);
             assert_eq!(s.len(), rows.len());
-            let one_by_one = crate::numerics::on_rows(rows, |i| a.get(i).copied());
+            let one_by_one: Option<Vec<f64>> = rows.iter().map(|&i| a.get(i).copied()).collect();
             assert_eq!(s.gather(&a), one_by_one, "{rows:?}");
-            let diff = crate::numerics::on_rows(rows, |i| Some(a.get(i)? - b.get(i)?));
+            let diff: Option<Vec<f64>> = rows.iter().map(|&i| Some(a.get(i)? - b.get(i)?)).collect();
             assert_eq!(s.map2(&a, &b, |x, y| x - y), diff, "{rows:?}");
         }
         // A row past the end of either is no result.

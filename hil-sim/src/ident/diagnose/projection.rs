@@ -129,8 +129,7 @@ impl Projection {
         // the others and the right-hand side in one pass over the rows.
         let mut with_t: Vec<&[f64]> = cols.iter().map(|c| c.values.as_slice()).collect();
         with_t.push(&t);
-        let pairs: Vec<(usize, usize)> = (0..k)
-            .flat_map(|a| (a..k).map(move |b| (a, b)))
+        let pairs: Vec<(usize, usize)> = lstsq::upper_pairs(k)
             .filter(|&(a, b)| self.products[a * k + b].is_none())
             .chain((0..k).map(|a| (a, k)))
             .collect();
