@@ -208,6 +208,9 @@ pub enum Set {
     /// The sixty-first, first run for the closing report of issue 20 (the eighteenth report's
     /// method, the host tools compiled for the CPU that builds them).
     Fresh60,
+    /// The sixty-second, first run for the twenty-fifth report (a field saturation beside the
+    /// base's level term no finding).
+    Fresh61,
 }
 
 impl Set {
@@ -276,6 +279,7 @@ impl Set {
         ("fresh58", Set::Fresh58, 922_000_000, 293),
         ("fresh59", Set::Fresh59, 952_000_000, 307),
         ("fresh60", Set::Fresh60, 1_000_000_000, 311),
+        ("fresh61", Set::Fresh61, 1_040_000_000, 313),
     ];
 
     /// The seed of case `k` of this set.
