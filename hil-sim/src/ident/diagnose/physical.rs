@@ -4,10 +4,11 @@
 //! a loop that narrows both ways from the mean of a field of one polarity (at its low end
 //! too), a field levelling off while the base's level term ([`super::level_map`]) keeps
 //! growing faster than linearly with the field as recorded (two opposite curvatures of one
-//! static curve: on fresh60's and fresh58's dumps, the one field saturation kept on such a
-//! base was a null's, and another was a second finding on a lag's; none of the 49 right ones
-//! had the term), or a lag, delay or channel lag pinned at the edge of its search range (the
-//! refit wanted more than the range allows: the term is standing in for something else).
+//! static curve: on fresh60's and fresh58's dumps, the two field saturations kept on such a
+//! base were a null's and a second finding on a lag's; none of the 27 kept on saturation
+//! cases had the term), or a lag, delay or channel lag pinned at the edge of its search
+//! range (the refit wanted more than the range allows: the term is standing in for
+//! something else).
 //!
 //! And what a fitted candidate stands for ([`reading`]): the catalog's asymmetry is a loop
 //! *widening* with the input; a direction or loading-branch term that *narrows* the loop as a
