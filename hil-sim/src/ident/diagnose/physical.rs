@@ -3,7 +3,8 @@
 //! yield-stress saturation that expands the torque instead or turns it down at the top,
 //! a loop that narrows both ways from the mean of a field of one polarity (at its low end
 //! too), a field levelling off while the base's level term ([`super::level_map`]) keeps
-//! growing faster than linearly with the field as recorded (two opposite curvatures of one
+//! growing faster than linearly with the field as recorded, on a base without play operators
+//! ([`level_power`]; two opposite curvatures of one
 //! static curve: on fresh60's and fresh58's dumps, the two field saturations kept on such a
 //! base were a null's and a second finding on a lag's; none of the 27 kept on saturation
 //! cases had the term), or a lag, delay or channel lag pinned at the edge of its search
@@ -145,9 +146,19 @@ pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64, 
 }
 
 /// The exponent of the level term ([`super::level_map`]) among the reference's `n_old` terms
-/// of `f`, when the base has one.
+/// of `f`, when the base has one and no play operators. On the play host the saturating map
+/// reaches the plays and the host's own odd cubic (its convex part, weight ≥ 0), so the
+/// model's faster-than-linear growth does level off with the field: there a field saturation
+/// stands (fresh52's `744004734`, a tanh saturation under a play truth, 0.35 % -> 0.14 %
+/// beside a level term of p = 2.81, is named by it; the regression test
+/// `a_play_truths_curve_is_the_hosts_with_its_cubic` caught the first form of the rule, which
+/// had ruled it out too).
 fn level_power(f: &Fitted, n_old: usize) -> Option<f64> {
-    f.terms.iter().take(n_old).find_map(|t| match t.of_input {
+    let base = || f.terms.iter().take(n_old);
+    if base().any(|t| matches!(t.of_input, Some((InputMap::Play { .. }, _)))) {
+        return None;
+    }
+    base().find_map(|t| match t.of_input {
         Some((InputMap::LevelPower { p, .. }, _)) => Some(p),
         _ => None,
     })
@@ -367,6 +378,9 @@ mod tests {
         assert!(why.as_deref().is_some_and(|w| w.contains("to the power 1.70")), "{why:?}");
         // Without the level term, or with it among the candidate's own terms only, it stands.
         assert_eq!(impossible(&c, &with(vec![]), 0, 0.41, 1e-3, &x), None);
-        assert_eq!(impossible(&c, &with(vec![level]), 0, 0.41, 1e-3, &x), None);
+        assert_eq!(impossible(&c, &with(vec![level.clone()]), 0, 0.41, 1e-3, &x), None);
+        // On the play host the map reaches the plays and its cubic: the field's saturation stands.
+        let play = Term::of_input("play_5pct", InputMap::Play { radius: 0.05 }, &x);
+        assert_eq!(impossible(&c, &with(vec![play, level]), 2, 0.41, 1e-3, &x), None);
     }
 }
