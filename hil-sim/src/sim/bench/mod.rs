@@ -211,6 +211,9 @@ pub enum Set {
     /// The sixty-second, first run for the twenty-fifth report (a field saturation beside the
     /// base's level term no finding).
     Fresh61,
+    /// The sixty-third, first run for the twenty-fifth report's second form of that rule (the
+    /// play host spared).
+    Fresh62,
 }
 
 impl Set {
@@ -280,6 +283,7 @@ impl Set {
         ("fresh59", Set::Fresh59, 952_000_000, 307),
         ("fresh60", Set::Fresh60, 1_000_000_000, 311),
         ("fresh61", Set::Fresh61, 1_040_000_000, 313),
+        ("fresh62", Set::Fresh62, 1_080_000_000, 317),
     ];
 
     /// The seed of case `k` of this set.
