@@ -73,8 +73,7 @@ impl InputMap {
     /// the transforms in time (delay, lags): its exponent is fitted once, before the rounds,
     /// and a saturating map or an offset composed with it is a second curvature that fits
     /// whatever shape its one exponent missed (on fresh12's nulls, a power-law truth's
-    /// exponent fitted 1.8–2.0 for 1.4, then "saturated" back: 2 false alarms). Nor is a
-    /// saturating map of the base's input alone kept beside it ([`super::physical::impossible`]).
+    /// exponent fitted 1.8–2.0 for 1.4, then "saturated" back: 2 false alarms).
     pub fn follows(&self, t: &Transform) -> bool {
         match self {
             Self::Play { .. } | Self::Cube { .. } => true,

@@ -2,21 +2,15 @@
 //! negative mass or inertia, a time constant or saturation level that is not positive, a
 //! yield-stress saturation that expands the torque instead or turns it down at the top,
 //! a loop that narrows both ways from the mean of a field of one polarity (at its low end
-//! too), a field levelling off while the base's level term ([`super::level_map`]) keeps
-//! growing faster than linearly with the field as recorded, on a base without play operators
-//! ([`level_power`]; two opposite curvatures of one
-//! static curve: on fresh60's and fresh58's dumps, the two field saturations kept on such a
-//! base were a null's and a second finding on a lag's; none of the 27 kept on saturation
-//! cases had the term), or a lag, delay or channel lag pinned at the edge of its search
-//! range (the refit wanted more than the range allows: the term is standing in for
-//! something else).
+//! too), or a lag, delay or channel lag pinned at the edge of its search range (the refit
+//! wanted more than the range allows: the term is standing in for something else).
 //!
 //! And what a fitted candidate stands for ([`reading`]): the catalog's asymmetry is a loop
 //! *widening* with the input; a direction or loading-branch term that *narrows* the loop as a
 //! field of one polarity grows, or the squared form narrowing it towards both ends of a
 //! two-sided field, is the yield stress levelling off at high field, a `saturation`.
 
-use super::augment::{Fitted, InputMap};
+use super::augment::Fitted;
 use super::candidates::{Candidate, DIRECTION_SQUARED_TERM, DIRECTION_TERM, LOADING_TERM};
 
 /// A field whose negative side reaches at most this share of its top is of positive polarity
@@ -112,14 +106,6 @@ pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64, 
             ));
         }
     }
-    let field_saturation = c.grid_name.as_deref() == Some("b_sat") && value > 0.0;
-    if let Some(p) = level_power(f, n_old).filter(|_| field_saturation) {
-        return Some(format!(
-            "a field levelling off under the base's static term in the input to the power {p:.2}, which keeps growing \
-             faster than linearly with the field as recorded: the same fluid's yield stress cannot do both, and the two \
-             opposite curvatures only reshape one static curve"
-        ));
-    }
     let name = c.grid_name.as_deref()?;
     if c.grid.len() < 2 {
         return None;
@@ -143,25 +129,6 @@ pub fn impossible(c: &Candidate, f: &Fitted, n_old: usize, value: f64, dt: f64, 
         }
         _ => None,
     }
-}
-
-/// The exponent of the level term ([`super::level_map`]) among the reference's `n_old` terms
-/// of `f`, when the base has one and no play operators. On the play host the saturating map
-/// reaches the plays and the host's own odd cubic (its convex part, weight ≥ 0), so the
-/// model's faster-than-linear growth does level off with the field: there a field saturation
-/// stands (fresh52's `744004734`, a tanh saturation under a play truth, 0.35 % -> 0.14 %
-/// beside a level term of p = 2.81, is named by it; the regression test
-/// `a_play_truths_curve_is_the_hosts_with_its_cubic` caught the first form of the rule, which
-/// had ruled it out too).
-fn level_power(f: &Fitted, n_old: usize) -> Option<f64> {
-    let base = || f.terms.iter().take(n_old);
-    if base().any(|t| matches!(t.of_input, Some((InputMap::Play { .. }, _)))) {
-        return None;
-    }
-    base().find_map(|t| match t.of_input {
-        Some((InputMap::LevelPower { p, .. }, _)) => Some(p),
-        _ => None,
-    })
 }
 
 /// Why an asymmetry term of coefficient `coef` makes the loop *narrower* as the input `x`
@@ -347,40 +314,5 @@ mod tests {
             assert!(why(d).is_some_and(|w| w.contains("edge of its search range")), "{d}: {:?}", why(d));
         }
         assert!(why(0.0004).is_some_and(|w| w.contains("shorter than one sample")));
-    }
-
-    #[test]
-    fn a_field_saturation_under_a_level_term_is_two_curvatures_not_a_finding() {
-        // fresh60's null `1031106531`: LuGre with a static b^1.70 term "saturated" back at
-        // 0.41 T by the sharp knee, 1.51 % -> 0.89 % held out, on a Bouc-Wen truth whose
-        // static curve is |b|^1.3.
-        let c = Candidate {
-            effect: "saturation",
-            label: "saturating map of the input with a sharp knee".into(),
-            grid_name: Some("b_sat".into()),
-            grid: vec![0.3, 0.6, 1.2],
-            build: Box::new(|b| Piece { transform: Some(Transform::SaturateKnee { b_sat: b }), terms: vec![] }),
-            channel: None,
-        };
-        let x: Vec<f64> = (0..=100).map(|i| f64::from(i) / 100.0 - 0.5).collect();
-        let level = Term::of_input("level_power", InputMap::LevelPower { x_ref: 0.5, p: 1.7 }, &x);
-        let with = |terms: Vec<Term>| Fitted {
-            transforms: vec![Transform::SaturateKnee { b_sat: 0.41 }],
-            beta: vec![1.0; terms.len()],
-            terms,
-            theta: vec![],
-            model: vec![],
-            pred: vec![],
-            train_mse: 0.0,
-        };
-        let on_level = with(vec![level.clone()]);
-        let why = impossible(&c, &on_level, 1, 0.41, 1e-3, &x);
-        assert!(why.as_deref().is_some_and(|w| w.contains("to the power 1.70")), "{why:?}");
-        // Without the level term, or with it among the candidate's own terms only, it stands.
-        assert_eq!(impossible(&c, &with(vec![]), 0, 0.41, 1e-3, &x), None);
-        assert_eq!(impossible(&c, &with(vec![level.clone()]), 0, 0.41, 1e-3, &x), None);
-        // On the play host the map reaches the plays and its cubic: the field's saturation stands.
-        let play = Term::of_input("play_5pct", InputMap::Play { radius: 0.05 }, &x);
-        assert_eq!(impossible(&c, &with(vec![play, level]), 2, 0.41, 1e-3, &x), None);
     }
 }

@@ -208,11 +208,10 @@ pub enum Set {
     /// The sixty-first, first run for the closing report of issue 20 (the eighteenth report's
     /// method, the host tools compiled for the CPU that builds them).
     Fresh60,
-    /// The sixty-second, first run for the twenty-fifth report (a field saturation beside the
-    /// base's level term no finding).
+    /// The sixty-second and sixty-third, first run for the twenty-fifth report (a field
+    /// saturation beside the base's level term no finding; on fresh62 with the play host
+    /// spared): the rule lost true saturations on fresh62 and was taken back.
     Fresh61,
-    /// The sixty-third, first run for the twenty-fifth report's second form of that rule (the
-    /// play host spared).
     Fresh62,
 }
 
