@@ -126,6 +126,8 @@ pub struct Diagnosis {
     pub final_heldout: Metrics,
     /// Base models tried by `auto`, with their held-out R-RMSE.
     pub bases_tried: Vec<(String, f64)>,
+    /// Every base `auto` gave a first round ([`super::contenders`]), with what it found there.
+    pub contenders: Vec<super::contenders::Contender>,
     pub locate: Locate,
     pub channels: Vec<AuxChannel>,
     pub candidates: Vec<Tested>,

@@ -150,9 +150,11 @@ fn diagnose_at_rate(
         feeds: Default::default(),
     };
     let mut openings = contenders::open_all(&fitted, &shared)?;
+    let withdrawn = contenders::withdraw_unsupported(&mut openings, &judge0);
     let chosen = contenders::choose(&openings, &judge0);
-    let mut notes: Vec<String> = fitted.failed.iter().cloned().chain(rate_note).collect();
+    let mut notes: Vec<String> = fitted.failed.iter().cloned().chain(rate_note).chain(withdrawn).collect();
     notes.extend(contenders::notes(&openings, chosen, &judge0, names));
+    let contenders = contenders::summaries(&openings, chosen, &judge0);
     let contenders::Opening { base, before, prob, mut current, located, first, .. } = openings.swap_remove(chosen);
     let id = base.fit.model.clone();
     let judge = Judge { noise_rms: located.noise_rms, ..judge0 };
@@ -221,6 +223,7 @@ fn diagnose_at_rate(
         reference_heldout,
         final_heldout,
         bases_tried: fitted.tried,
+        contenders,
         locate: located,
         channels,
         candidates: tested,
