@@ -213,10 +213,11 @@ pub enum Set {
     /// spared): the rule lost true saturations on fresh62 and was taken back.
     Fresh61,
     Fresh62,
-    /// The sixty-fourth, first run for the twenty-sixth report (a field saturation that no
-    /// other base weighed finds significant, on the play host or on a base other than the one
-    /// predicting best without a finding, is withdrawn: `contenders::ASK_SUPPORT`).
+    /// The sixty-fourth and sixty-fifth, first run for the twenty-sixth report (a field
+    /// saturation that no other base weighed finds significant is no reason to leave the base
+    /// that predicts best without a finding: `contenders::ASK_SUPPORT`).
     Fresh63,
+    Fresh64,
 }
 
 impl Set {
@@ -288,6 +289,7 @@ impl Set {
         ("fresh61", Set::Fresh61, 1_040_000_000, 313),
         ("fresh62", Set::Fresh62, 1_080_000_000, 317),
         ("fresh63", Set::Fresh63, 1_120_000_000, 331),
+        ("fresh64", Set::Fresh64, 1_160_000_000, 337),
     ];
 
     /// The seed of case `k` of this set.
