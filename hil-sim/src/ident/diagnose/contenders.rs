@@ -186,7 +186,9 @@ pub fn choose(openings: &[Opening<'_>], judge: &Judge<'_>) -> usize {
 /// the 80 nulls an opening not chosen held such a lone saturation. The base that predicts
 /// best without a finding keeps a lone one: the play host's true saturation on fresh52's
 /// `744004734` is lone, the other bases missing the plays' loop by three times its error
-/// (and so is fresh45's false alarm `568705221`, which stands).
+/// (and so is fresh45's false alarm `568705221`, which stands). On held-out fresh63–fresh65
+/// it lost one right case (`1200006246`: two bases weighed, the play host 10.9 % → 1.0 %
+/// with a true saturation that Bouc–Wen, at 3.3 %, did not find) and removed no false alarm.
 pub const ASK_SUPPORT: &[&str] = &["saturation"];
 
 /// The effects whose candidates, in `o`'s first round, predicted the held-out part better,

@@ -213,11 +213,12 @@ pub enum Set {
     /// spared): the rule lost true saturations on fresh62 and was taken back.
     Fresh61,
     Fresh62,
-    /// The sixty-fourth and sixty-fifth, first run for the twenty-sixth report (a field
+    /// The sixty-fourth to sixty-sixth, first run for the twenty-sixth report (a field
     /// saturation that no other base weighed finds significant is no reason to leave the base
     /// that predicts best without a finding: `contenders::ASK_SUPPORT`).
     Fresh63,
     Fresh64,
+    Fresh65,
 }
 
 impl Set {
@@ -290,6 +291,7 @@ impl Set {
         ("fresh62", Set::Fresh62, 1_080_000_000, 317),
         ("fresh63", Set::Fresh63, 1_120_000_000, 331),
         ("fresh64", Set::Fresh64, 1_160_000_000, 337),
+        ("fresh65", Set::Fresh65, 1_200_000_000, 347),
     ];
 
     /// The seed of case `k` of this set.
