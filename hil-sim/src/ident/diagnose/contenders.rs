@@ -288,6 +288,20 @@ pub fn summaries(openings: &[Opening<'_>], chosen: usize, judge: &Judge<'_>) -> 
         .collect()
 }
 
+/// The contenders settled: lone findings withdrawn ([`withdraw_unsupported`]), the opening
+/// the diagnosis goes on with ([`choose`]), the notes on both ([`notes`]) and every
+/// opening's [`Contender`].
+pub fn settle(
+    openings: &mut [Opening<'_>],
+    judge: &Judge<'_>,
+    names: (&str, &str),
+) -> (usize, Vec<String>, Vec<Contender>) {
+    let mut out = withdraw_unsupported(openings, judge);
+    let chosen = choose(openings, judge);
+    out.extend(notes(openings, chosen, judge, names));
+    (chosen, out, summaries(openings, chosen, judge))
+}
+
 /// The notes a diagnosis carries about its base, the opening `chosen` (`names`: the input's
 /// and the output's): why it is not the best-fitting base, its play operators, its level
 /// term.

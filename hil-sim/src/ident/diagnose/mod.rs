@@ -150,11 +150,8 @@ fn diagnose_at_rate(
         feeds: Default::default(),
     };
     let mut openings = contenders::open_all(&fitted, &shared)?;
-    let withdrawn = contenders::withdraw_unsupported(&mut openings, &judge0);
-    let chosen = contenders::choose(&openings, &judge0);
-    let mut notes: Vec<String> = fitted.failed.iter().cloned().chain(rate_note).chain(withdrawn).collect();
-    notes.extend(contenders::notes(&openings, chosen, &judge0, names));
-    let contenders = contenders::summaries(&openings, chosen, &judge0);
+    let (chosen, settled, contenders) = contenders::settle(&mut openings, &judge0, names);
+    let mut notes: Vec<String> = fitted.failed.iter().cloned().chain(rate_note).chain(settled).collect();
     let contenders::Opening { base, before, prob, mut current, located, first, .. } = openings.swap_remove(chosen);
     let id = base.fit.model.clone();
     let judge = Judge { noise_rms: located.noise_rms, ..judge0 };
