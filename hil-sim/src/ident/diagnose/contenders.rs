@@ -144,11 +144,18 @@ pub fn open_all<'a>(bases: &'a Bases, s: &Shared<'a, '_>) -> Result<Vec<Opening<
 
 /// The held-out RMSE of an opening without a finding, and with its first round's finding.
 fn errors(o: &Opening<'_>, judge: &Judge<'_>) -> (f64, Option<f64>) {
+    // A finding kept on the split where it acts ([`super::acting`]) has no say here: the
+    // bases are weighed on the tail.
+    let with = o.first.as_ref().and_then(|(_, v)| v.accepted.as_ref()).filter(|a| a.acting.is_none());
+    (alone(o, judge).rmse, with.map(|a| a.after.rmse))
+}
+
+/// The held-out metrics of an opening without a finding: its first round's reference, or
+/// the converged base when the round could not be taken.
+fn alone(o: &Opening<'_>, judge: &Judge<'_>) -> crate::numerics::metrics::Metrics {
     match &o.first {
-        // A finding kept on the split where it acts ([`super::acting`]) has no say here: the
-        // bases are weighed on the tail.
-        Some((_, v)) => (v.before.rmse, v.accepted.as_ref().filter(|a| a.acting.is_none()).map(|a| a.after.rmse)),
-        None => (judge.heldout(&o.current.pred).rmse, None),
+        Some((_, v)) => v.before,
+        None => judge.heldout(&o.current.pred),
     }
 }
 
@@ -194,8 +201,8 @@ pub const ASK_SUPPORT: &[&str] = &["saturation"];
 /// The effects whose candidates, in `o`'s first round, predicted the held-out part better,
 /// significantly by the paired block test, with possible values, and not as an effect an
 /// earlier round named.
-fn significant<'o>(o: &'o Opening<'_>) -> Vec<&'o str> {
-    let mut out: Vec<&str> = Vec::new();
+fn significant(o: &Opening<'_>) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
     let tested = o.first.as_ref().map_or(&[][..], |(_, v)| v.tested.as_slice());
     for t in tested.iter().filter(|t| {
         t.test.significant
@@ -203,8 +210,8 @@ fn significant<'o>(o: &'o Opening<'_>) -> Vec<&'o str> {
             && !t.named_before
             && t.heldout_r_rmse_after < t.heldout_r_rmse_before
     }) {
-        if !out.contains(&t.effect.as_str()) {
-            out.push(&t.effect);
+        if !out.contains(&t.effect) {
+            out.push(t.effect.clone());
         }
     }
     out
@@ -214,10 +221,9 @@ fn significant<'o>(o: &'o Opening<'_>) -> Vec<&'o str> {
 /// found on no other opening, on a base other than the one that predicts best without a
 /// finding (the rule at [`ASK_SUPPORT`]); the notes say which.
 pub fn withdraw_unsupported(openings: &mut [Opening<'_>], judge: &Judge<'_>) -> Vec<String> {
-    let plain =
-        (0..openings.len()).min_by(|&a, &b| errors(&openings[a], judge).0.total_cmp(&errors(&openings[b], judge).0));
-    let found: Vec<Vec<String>> =
-        openings.iter().map(|o| significant(o).into_iter().map(str::to_owned).collect()).collect();
+    let errs: Vec<f64> = openings.iter().map(|o| errors(o, judge).0).collect();
+    let plain = (0..errs.len()).min_by(|&a, &b| errs[a].total_cmp(&errs[b]));
+    let found: Vec<Vec<String>> = openings.iter().map(significant).collect();
     let mut notes = Vec::new();
     for (k, o) in openings.iter_mut().enumerate() {
         let Some((_, verdict)) = o.first.as_mut() else { continue };
@@ -270,18 +276,15 @@ pub fn summaries(openings: &[Opening<'_>], chosen: usize, judge: &Judge<'_>) -> 
         .iter()
         .enumerate()
         .map(|(k, o)| {
-            let (before, accepted) = match &o.first {
-                Some((_, v)) => (v.before, v.accepted.as_ref()),
-                None => (judge.heldout(&o.current.pred), None),
-            };
+            let accepted = o.first.as_ref().and_then(|(_, v)| v.accepted.as_ref());
             Contender {
                 base_model: o.base.fit.model.clone(),
                 plays: o.plays,
                 level_exponent: o.level,
-                heldout_r_rmse: before.r_rmse,
+                heldout_r_rmse: alone(o, judge).r_rmse,
                 finding: accepted.map(|a| a.reading.effect.to_owned()),
                 finding_r_rmse: accepted.map(|a| a.after.r_rmse),
-                significant: significant(o).into_iter().map(str::to_owned).collect(),
+                significant: significant(o),
                 chosen: k == chosen,
             }
         })
@@ -335,10 +338,7 @@ fn note(openings: &[Opening<'_>], chosen: usize, judge: &Judge<'_>) -> Option<St
         return None;
     }
     let pct = |m: &crate::numerics::metrics::Metrics| format!("{:.2} %", 100.0 * m.r_rmse);
-    let alone = |o: &Opening<'_>| match &o.first {
-        Some((_, v)) => v.before,
-        None => judge.heldout(&o.current.pred),
-    };
+    let alone = |o: &Opening<'_>| alone(o, judge);
     let ids = if picked.plays {
         format!("{} with play operators", picked.base.fit.model)
     } else {
