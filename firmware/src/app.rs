@@ -104,6 +104,7 @@ async fn main(spawner: Spawner) {
 
     let Ok(loaded) = store::load(&BoardFlash, &Defmt) else { fatal("compiled-in configuration rejected") };
     SHARED.booted(loaded.running, loaded.damaged, loaded.crc);
+    SHARED.set_limits(&loaded.cfg, loaded.lp.control_hz());
     Interrupts.running(loaded.running, loaded.damaged);
     let _flash_owner = b.flash;
 

@@ -5,13 +5,16 @@
 //! `preisach`'s control step (its 50 × 50 weight table, 10 KB) is built in place in a static
 //! slot the [`Loop`] owns ([`PreisachSlot`]), so neither the commit and boot paths nor the
 //! control interrupt's swap copy it. Each model runs at its own control rate
-//! ([`control_hz_of`], [`Loop::control_hz`]).
+//! ([`control_hz_of`], [`Loop::control_hz`]). The physics check of a page's model
+//! ([`model_core::control::physics`]) runs on the estimator a [`Loop`] holds
+//! ([`Loop::sweep`]), so every built-in model has it and Preisach's table is not copied.
 
 use core::cell::UnsafeCell;
 use core::mem::MaybeUninit;
 use core::sync::atomic::{AtomicBool, Ordering};
-use model_core::control::ValidatedConfig;
+use model_core::control::physics::Sweep;
 use model_core::control::{ConfigImage, ControlInput, ControlOutput, ControlState, ControlStep, PageError};
+use model_core::control::{ControlConfig, PhysicsFault, ValidatedConfig};
 
 use model_core::models::{
     algebraic, bouc_wen, bouc_wen_asym, dahl, gpi, hammerstein_wiener, lugre, maxwell_slip, narx, prandtl_ishlinskii,
@@ -265,6 +268,30 @@ macro_rules! define_loop {
                     $(Self::$v(s, st) => Store::<$m>::get(s).step(cfg, st, x),)*
                 }
             }
+
+            /// The physics check of this controller's estimator (its model, rate
+            /// estimator and time step) over the field range and against the rating of
+            /// `control` (the page's settings), to advance in chunks.
+            pub fn sweep(&self, control: &ControlConfig) -> LoopSweep<'_> {
+                match self {
+                    $(Self::$v(s, _) => LoopSweep::$v(Sweep::new(&Store::<$m>::get(s).est, control)),)*
+                }
+            }
+        }
+
+        /// A physics check in progress on a [`Loop`]'s estimator ([`Loop::sweep`]).
+        pub enum LoopSweep<'a> {
+            $($v(Sweep<'a, $m>),)*
+        }
+
+        impl LoopSweep<'_> {
+            /// At most `max_steps` samples of the sweep: `None` while it goes on, then the
+            /// verdict ([`Sweep::advance`]).
+            pub fn advance(&mut self, max_steps: u32) -> Option<Result<(), PhysicsFault>> {
+                match self {
+                    $(Self::$v(s) => s.advance(max_steps),)*
+                }
+            }
         }
     };
 }
@@ -314,8 +341,12 @@ mod tests {
         ConfigImage::new("preisach", &p, img.rate, control).expect("page")
     }
 
+    /// Held by the tests that take Preisach slots: one of them fills every slot.
+    static SLOT_TESTS: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
     #[test]
     fn preisach_runs_from_a_static_slot_as_built_by_value() {
+        let _one = SLOT_TESTS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         let img = preisach_page(10_000.0);
         assert!(matches!(Loop::from_image(&preisach_page(20_000.0)), Err(PageError::Malformed(_))));
         let mut lp = Loop::from_image(&img).expect("preisach loop");
@@ -339,6 +370,34 @@ mod tests {
         assert!(matches!(Loop::from_image(&img), Err(PageError::Malformed(_))));
         held.pop();
         assert!(Loop::from_image(&img).is_ok(), "a dropped Loop frees its slot");
+    }
+
+    /// A [`LoopSweep`] to its verdict.
+    fn swept(lp: &Loop, img: &ConfigImage) -> Result<(), PhysicsFault> {
+        let mut sweep = lp.sweep(img.control.get());
+        loop {
+            if let Some(v) = sweep.advance(1000) {
+                return v;
+            }
+        }
+    }
+
+    #[test]
+    fn the_physics_sweep_runs_on_the_loops_estimator_as_on_one_built_by_value() {
+        let _one = SLOT_TESTS.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        use model_core::control::physics::{check, page_estimator};
+        let img = crate::bringup::default_image().expect("image");
+        let lp = Loop::from_image(&img).expect("loop");
+        let by_value = page_estimator::<algebraic::Registered>(&img).expect("estimator");
+        assert_eq!(swept(&lp, &img), check(&by_value, img.control.get()));
+        assert_eq!(swept(&lp, &img), Ok(()));
+        // Preisach's from its static slot (its table not copied).
+        let img = preisach_page(10_000.0);
+        let lp = Loop::from_image(&img).expect("preisach loop");
+        let by_value = page_estimator::<preisach::Registered>(&img).expect("estimator");
+        assert_eq!(swept(&lp, &img), check(&by_value, img.control.get()));
+        // The test page's 1275 relays sum to about 300 N·m at b_max: beyond the rating.
+        assert!(matches!(swept(&lp, &img), Err(PhysicsFault::ExceedsRating { .. })));
     }
 
     #[test]

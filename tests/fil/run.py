@@ -49,6 +49,57 @@ def send(m, data, periods=4):
         m.period(QUIET)
 
 
+class Host:
+    """A host on CAN as `model_core::protocol::session` wants it: it claims the board, then
+    every driving command carries its session and sequence number (the tag) and a deadline
+    300 ms ahead of the board's clock, followed from the session reply's clock."""
+
+    NONCE = 0x4242
+
+    def __init__(self):
+        self.tag = None  # the tag of the last command sent
+        self.clock = None  # (board ms, emulated ns) at the session reply
+
+    def claim_frame(self):
+        return bytes([0x06]) + struct.pack("<H", self.NONCE)
+
+    def take_session(self, m):
+        """The session reply, once it has been sent (False before)."""
+        for _, d in m.can.sent:
+            if d[:1] == b"\x85" and struct.unpack("<H", d[1:3])[0] == self.NONCE:
+                tag, ms = struct.unpack("<HH", d[3:7])
+                self.tag = (tag & 0xF000) | ((tag - 1) & 0x0FFF)
+                self.clock = (ms, m.now)
+                return True
+        return False
+
+    def claim(self, m):
+        send(m, self.claim_frame())
+        for _ in range(200):
+            if self.take_session(m):
+                return
+            m.period(QUIET)
+        raise AssertionError("no session granted: %r" % m.can.sent[-3:])
+
+    def guarded(self, m, code, payload=b""):
+        self.tag = (self.tag & 0xF000) | ((self.tag + 1) & 0x0FFF)
+        ms, at = self.clock
+        deadline = (ms + (m.now - at) // 1_000_000 + 300) & 0xFFFF
+        return bytes([code]) + struct.pack("<HH", self.tag, deadline) + payload
+
+    def enable(self, m):
+        return self.guarded(m, 0x02, b"\x01")
+
+    def torque(self, m, v):
+        milli = int(round(v * 1000))
+        return self.guarded(m, 0x01, struct.pack("<i", milli)[:3])
+
+
+def acked(sent, code):
+    """Whether the board acknowledged a command with this byte."""
+    return any(d[:2] == bytes([0x82, code]) for _, d in sent)
+
+
 class Plant:
     """The coil and the Hall sensor, enough to keep the loop's plausibility checks quiet:
     i' = (V − R·i)/L with V = duty · supply, B = 0.2 T/A · i, 12-bit readings with the
@@ -101,12 +152,16 @@ def control(elf, periods, trace_csv, flash_path=None):
     supply_v = supply * (3.3 / 4095 * 11)
     driven = 0
     start = None  # the first period with a control step (a Preisach page boots in ~350)
+    host = Host()
     for k in range(periods):
-        if start is not None and k == start + 100:
-            m.can.receive(m, 0x120, bytes([0x02, 1]))
+        if start is not None and k == start + 50:
+            m.can.receive(m, 0x120, host.claim_frame())
+        elif start is not None and k == start + 100:
+            assert host.take_session(m), "no session granted by period %d" % k
+            m.can.receive(m, 0x120, host.enable(m))
         elif start is not None and k > start + 100 and k % 20 == 0:
             # The set-point streamed at 1 kHz (the command timeout is 100 ms).
-            m.can.receive(m, 0x120, bytes([0x01]) + struct.pack("<f", reference(k)))
+            m.can.receive(m, 0x120, host.torque(m, reference(k)))
         h, i, s = plant.sample(supply)
         seen = (b(addr["en"]), m.read_u32(addr["ref"]), b(addr["reset"]), b(addr["stall"]))
         slow0, n0 = m.read_u32(addr["slow"]), m.read_u32(addr["n"])
@@ -123,17 +178,19 @@ def control(elf, periods, trace_csv, flash_path=None):
         plant.advance(c1, c2, moe, supply_v)
         out.write("%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d,%d\n" % (ran, h, i, s, *seen, slow, c1, c2, int(moe)))
     out.close()
-    if m.can.sent[:1] != [(0x121, bytes([0x82, 0x02]))]:
+    if not acked(m.can.sent, 0x02):
         raise AssertionError("no ack of the enable command: %r" % m.can.sent[:3])
     print("control: %d periods traced from reset (first control step in period %d), bridge driving in %d" % (periods, start if start is not None else -1, driven))
 
 
 def running(m, periods=200):
     """Enable with a torque reference and run until the bridge drives."""
-    send(m, bytes([0x02, 1]))
+    host = Host()
+    host.claim(m)
+    send(m, host.enable(m))
     for k in range(3000):
         if k % 20 == 0:
-            m.can.receive(m, 0x120, bytes([0x01]) + struct.pack("<f", 2.0))
+            m.can.receive(m, 0x120, host.torque(m, 2.0))
         m.period((2048 + (k % 7), 2048 + (k % 5), 2200))
         if m.tim1.moe:
             return True
@@ -220,8 +277,8 @@ def faults(elf):
     return results
 
 
-def commit_frames(page):
-    frames = [bytes([0x10]) + struct.pack("<H", len(page))]
+def commit_frames(m, host, page):
+    frames = [host.guarded(m, 0x10, struct.pack("<H", len(page)))]
     for off in range(0, len(page), 5):
         frames.append(bytes([0x11]) + struct.pack("<H", off) + page[off:off + 5])
     frames.append(bytes([0x12]) + struct.pack("<I", zlib.crc32(page) & 0xFFFF_FFFF))
@@ -237,8 +294,10 @@ def source(m):
 def commit(m, page, cut_at=None):
     """Send a page over CAN and wait for the commit's reply (or the cut's reset)."""
     m.flash.cut_at = cut_at
+    host = Host()
+    host.claim(m)
     m.can.sent.clear()
-    for f in commit_frames(page):
+    for f in commit_frames(m, host, page):
         send(m, f, periods=1)
     for _ in range(4000):
         m.period(QUIET)
@@ -264,7 +323,7 @@ def powercut(elf, flash_path, page_path):
     assert old == ("A", 1), "the old page did not boot: %r" % (old,)
     before = m.flash.ops
     reply = commit(m, page)
-    assert reply == bytes([0x82, 0x12]), "commit refused: %r" % reply
+    assert reply[:2] == bytes([0x82, 0x12]), "commit refused: %r" % reply
     ops = m.flash.ops - before
     reboot(m, 0x0C00_0000)
     new = source(m)

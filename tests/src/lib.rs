@@ -1,1 +1,4 @@
 //! Integration tests across the crates live in `tests/tests/`.
+
+pub mod board;
+pub mod peer;

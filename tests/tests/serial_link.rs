@@ -20,7 +20,7 @@ use hil_sim::link::Link;
 use model_core::protocol::device::{Action, Device, StatusFigures};
 use model_core::protocol::frame::{encode, Deframer, MAX_ENCODED};
 use model_core::protocol::telemetry::Telemetry;
-use model_core::protocol::{Command, FRAME};
+use model_core::protocol::{Command, Sessions, FRAME};
 
 /// A pseudo-terminal pair in raw mode: the master end and the slave's path.
 fn openpty() -> (File, PathBuf, OwnedFd) {
@@ -103,6 +103,8 @@ struct BoardLog {
 fn board(master: File, noisy: Arc<AtomicBool>, stop: Arc<AtomicBool>, log: Arc<Mutex<BoardLog>>) {
     let mut master = master;
     let mut device = Device::default();
+    let mut sessions = Sessions::new();
+    let started = std::time::Instant::now();
     let mut deframer = Deframer::default();
     let (mut up, mut down) = (Line { rng: Rng(0x9E37_79B9_7F4A_7C15), p: 0.004 }, Line { rng: Rng(7), p: 0.004 });
     let (mut up_cut, mut down_cut) = (false, false);
@@ -120,16 +122,18 @@ fn board(master: File, noisy: Arc<AtomicBool>, stop: Arc<AtomicBool>, log: Arc<M
                 for b in rx {
                     let Some(Ok(p)) = deframer.push(b) else { continue };
                     let p = p.to_vec();
-                    let reply = match device.handle(&p) {
-                        (Action::Reference(t), r) => {
-                            reference = t;
-                            log.lock().unwrap().references.push(t);
-                            r
+                    let now_ms = started.elapsed().as_millis() as u64;
+                    let h = device.handle(&p, now_ms, &mut sessions);
+                    let reply = match h.action {
+                        Action::Reference { value, reply } => {
+                            reference = value;
+                            log.lock().unwrap().references.push(value);
+                            reply.map(|r| r.ack())
                         }
-                        (Action::Status, _) => {
+                        Action::Status => {
                             Some(device.status(StatusFigures { mode: 2, fault: 0, overruns: 0, torque_est: reference }))
                         }
-                        (_, r) => r,
+                        _ => h.reply,
                     };
                     if let Some(r) = reply {
                         let mut f = [0u8; FRAME];
@@ -182,7 +186,7 @@ fn garbage_and_dropped_bytes_on_a_tty_are_caught_counted_and_survived() {
     let mut answered = 0;
     for i in 0..150 {
         let v = i as f32 + 0.25;
-        link.send(Command::SetTorque(v)).expect("send");
+        link.stream_command(|guard| Command::SetTorque { guard, reference: v, ack: false }).expect("send");
         sent.push(v);
         if let Ok(s) = link.status() {
             answered += 1;

@@ -59,10 +59,11 @@ mod tests {
 
     #[test]
     fn a_reply_fits_one_classic_frame_from_the_reply_id() {
-        let f = reply(Response::Ack(7)).expect("a frame");
+        let ack = Response::Ack { code: 7, tag: 0x1005, now_ms: 65_000 };
+        let f = reply(ack).expect("a frame");
         assert_eq!(f.id, ID_REPLY);
         assert!(f.len as usize <= 8 && f.len > 0);
-        assert_eq!(Response::decode(f.data()), Some(Response::Ack(7)));
+        assert_eq!(Response::decode(f.data()), Some(ack));
         assert!(Command::decode(&[]).is_err());
     }
 }

@@ -1,14 +1,19 @@
 //! What the two command links share, and one frame's way through the command handler
-//! (`model_core::protocol::device::Device`): the action done, the reply returned.
+//! (`model_core::protocol::device::Device`): the action done, the reply returned. The
+//! board's session (`model_core::protocol::session`) is here, one for both links: one host
+//! controls the clutch, over whichever link it claimed.
 
 use core::cell::Cell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use critical_section::Mutex;
-use model_core::protocol::device::{Action, Device};
-use model_core::protocol::{Command, Nack, Response};
+use model_core::control::{FaultCode, LoopMode, Mode, ValidatedConfig};
+use model_core::protocol::device::{Action, Device, Reply};
+use model_core::protocol::session::Ended;
+use model_core::protocol::{mode_code, Nack, Response, Sessions};
 
 use super::ports::{Clock, ControlPort, Event, Events, FlashPages};
+use super::time::after;
 use super::{store, App};
 use crate::link::{LinkAction, LinkWatch, COMMAND_TIMEOUT_MS};
 use crate::slots::Slot;
@@ -26,6 +31,13 @@ pub struct Shared {
     /// CRC-32 of the page running (0: the compiled-in defaults): what both links' page-CRC
     /// query answers, from start-up on and after a commit over either link.
     active_crc: AtomicU32,
+    /// Who controls the clutch.
+    sessions: Mutex<Cell<Sessions>>,
+    /// The running page's reference limit (f32 bits; N·m, A in current mode), control rate
+    /// (Hz) and confirmation count of its fast checks (samples).
+    reference_max: AtomicU32,
+    control_hz: AtomicU32,
+    confirm: AtomicU32,
 }
 
 impl Shared {
@@ -37,7 +49,36 @@ impl Shared {
             committing: AtomicBool::new(false),
             damaged: AtomicBool::new(damaged),
             active_crc: AtomicU32::new(crc),
+            sessions: Mutex::new(Cell::new(Sessions::new())),
+            reference_max: AtomicU32::new(0),
+            control_hz: AtomicU32::new(0),
+            confirm: AtomicU32::new(0),
         }
+    }
+
+    /// The limits of the page that runs from now on (at start-up, and after a commit: a
+    /// page is committed only with the bridge off, and swapped in at the next sample).
+    pub fn set_limits(&self, cfg: &ValidatedConfig, control_hz: u32) {
+        let c = cfg.get();
+        let max = if c.mode == LoopMode::Current { c.i_max } else { c.torque_max };
+        self.reference_max.store(max.to_bits(), Ordering::Relaxed);
+        self.control_hz.store(control_hz, Ordering::Relaxed);
+        self.confirm.store(c.confirm_samples as u32, Ordering::Relaxed);
+    }
+
+    /// The running page's reference limit (N·m; A in current mode).
+    pub fn reference_max(&self) -> f32 {
+        f32::from_bits(self.reference_max.load(Ordering::Relaxed))
+    }
+
+    fn sessions<R>(&self, f: impl FnOnce(&mut Sessions) -> R) -> R {
+        critical_section::with(|cs| {
+            let cell = self.sessions.borrow(cs);
+            let mut s = cell.get();
+            let r = f(&mut s);
+            cell.set(s);
+            r
+        })
     }
 
     /// Set the start-up configuration (a `static` made before loading it).
@@ -78,17 +119,78 @@ fn now_ms(clock: &impl Clock) -> u64 {
     clock.now_us() / 1000
 }
 
-/// Release the drive when no link has been heard for `COMMAND_TIMEOUT_MS` (called on every
+/// Drive off, reference zero (the event logged when a drive was released).
+fn release<C, F, P: ControlPort, E: Events>(app: App<'_, C, F, P, E>) {
+    let driven = app.ctl.enabled();
+    app.ctl.set_enable(false);
+    app.ctl.set_reference(0.0);
+    if driven {
+        app.events.event(Event::Released);
+    }
+}
+
+/// Release the drive when its session's holder has not been heard for
+/// `COMMAND_TIMEOUT_MS`, and end a session silent for its idle time (called on every
 /// wake-up of a link task).
 pub fn watch_link<C: Clock, F, P: ControlPort, E: Events>(app: App<'_, C, F, P, E>, device: &mut Device) {
-    if app.shared.poll(now_ms(app.clock), app.ctl.enabled()) == LinkAction::Release {
-        app.ctl.set_enable(false);
-        app.ctl.set_reference(0.0);
-        app.events.event(Event::Released);
+    let now = now_ms(app.clock);
+    let ended = app.shared.sessions(|s| s.expire(now));
+    if app.shared.poll(now, app.ctl.enabled()) == LinkAction::Release || (ended == Ended::Yes && app.ctl.enabled()) {
+        release(app);
     }
     if !app.ctl.enabled() {
         device.released();
     }
+}
+
+/// A reset, answered once the control step has taken it and the fast checks have had
+/// their confirmation count of samples to latch a fault that is still there.
+async fn reset<C: Clock, F, P: ControlPort, E>(app: App<'_, C, F, P, E>, reply: Reply) -> Response {
+    app.ctl.request_reset();
+    let settle = app.shared.confirm.load(Ordering::Relaxed).saturating_add(2);
+    let start = app.ctl.samples();
+    // At most 50 ms: the slowest control rate with the largest count stays far inside.
+    for _ in 0..250 {
+        if app.ctl.samples().wrapping_sub(start) >= settle {
+            break;
+        }
+        after(app.clock, 200).await;
+    }
+    if faulted(app) {
+        reply.nack(Nack::FaultPresent)
+    } else {
+        reply.ack()
+    }
+}
+
+/// A fault is latched (as the last sample's status reads).
+fn faulted<C, F, P: ControlPort, E>(app: App<'_, C, F, P, E>) -> bool {
+    let st = app.ctl.status();
+    st.fault != 0 || st.mode == FAULT_MODE
+}
+
+/// The status byte of the fault mode.
+const FAULT_MODE: u8 = mode_code(Mode::Fault(FaultCode::None));
+
+/// An enable, refused while a fault is latched (a reset must clear it first).
+fn enable<C, F, P: ControlPort, E>(app: App<'_, C, F, P, E>, device: &mut Device, on: bool, reply: Reply) -> Response {
+    if on && faulted(app) {
+        device.released();
+        return reply.nack(Nack::Faulted);
+    }
+    app.ctl.set_enable(on);
+    reply.ack()
+}
+
+/// A reference within the running page's limit is applied; beyond it, refused (the
+/// streamed form is answered only then).
+fn reference<C, F, P: ControlPort, E>(app: App<'_, C, F, P, E>, value: f32, reply: Option<Reply>) -> Option<Response> {
+    let max = app.shared.reference_max();
+    if value.is_nan() || model_core::math::abs(value) > max {
+        return reply.map(|r| r.nack(Nack::OutOfRange));
+    }
+    app.ctl.set_reference(value);
+    reply.map(Reply::ack)
 }
 
 /// One frame from a link through the command handler: its action done, its reply returned.
@@ -97,42 +199,45 @@ pub async fn serve<C: Clock, F: FlashPages, P: ControlPort, E: Events>(
     device: &mut Device,
     data: &[u8],
 ) -> Option<Response> {
-    if Command::decode(data).is_ok() {
-        app.shared.heard(now_ms(app.clock));
-    }
+    let now = now_ms(app.clock);
     // The running page's CRC, whichever link committed it (or the slot it booted from).
     device.set_active_crc(app.shared.active_crc());
-    match device.handle(data) {
-        (Action::None, r) => r,
-        (Action::Reference(t), r) => {
-            app.ctl.set_reference(t);
-            r
+    let h = app.shared.sessions(|s| device.handle(data, now, s));
+    if h.heard {
+        app.shared.heard(now);
+    }
+    match h.action {
+        Action::None => h.reply,
+        Action::Reference { value, reply } => reference(app, value, reply),
+        Action::Enable { on, reply } => Some(enable(app, device, on, reply)),
+        Action::Reset { reply } => Some(reset(app, reply).await),
+        Action::Released { reply } => {
+            release(app);
+            Some(reply.ack())
         }
-        (Action::Enable(e), r) => {
-            app.ctl.set_enable(e);
-            r
-        }
-        (Action::Reset, r) => {
-            app.ctl.request_reset();
-            r
-        }
-        (Action::Status, _) => Some(device.status(app.ctl.status())),
-        (Action::Commit, _) => {
+        Action::Status => Some(device.status(app.ctl.status())),
+        Action::Limits => Some(Response::Limits {
+            reference_max: app.shared.reference_max(),
+            control_hz: u16::try_from(app.shared.control_hz.load(Ordering::Relaxed)).unwrap_or(u16::MAX),
+        }),
+        Action::Commit => {
             let result = match (device.take_page(), app.shared.committing.swap(true, Ordering::Acquire)) {
                 (_, true) => Err(Nack::Busy),
                 (None, false) => Err(Nack::Sequence),
                 (Some(img), false) => {
                     let r = store::commit(app, device.page_bytes(), &img, app.shared.running()).await;
                     app.shared.committing.store(false, Ordering::Release);
-                    r.map(|now| (now, img.crc()))
+                    r.map(|now| (now, img))
                 }
             };
-            if let Ok((now, crc)) = result {
-                critical_section::with(|cs| app.shared.running.borrow(cs).set(Some(now)));
-                app.shared.active_crc.store(crc, Ordering::Relaxed);
-                device.set_active_crc(crc);
+            if let Ok((running, img)) = &result {
+                critical_section::with(|cs| app.shared.running.borrow(cs).set(Some(*running)));
+                app.shared.active_crc.store(img.crc(), Ordering::Relaxed);
+                let hz = crate::runner::control_hz_of(img.model_id()).unwrap_or(0);
+                app.shared.set_limits(&img.control, hz);
+                device.set_active_crc(img.crc());
             }
-            Some(device.committed(result.map(|_| ())))
+            Some(device.committed(result.map(|_| ()), now_ms(app.clock)))
         }
     }
 }

@@ -1,14 +1,30 @@
 //! The configuration store: what a slot holds, which configuration boots, and a commit
-//! (validate the page, write it to the slot not running, read it back, hand it to the
-//! control interrupt).
+//! (validate the page, check its model's physics, write it to the slot not running, read it
+//! back, hand it to the control interrupt).
+//!
+//! The physics check ([`model_core::control::physics`]: the page's estimator on a slow
+//! sweep of the field, refused when not finite, beyond the rating or not rising with the
+//! field) runs in [`commit`] before flash is touched, in chunks with a yield between them
+//! ([`physics_chunked`]); [`physics`] is the same check at once, for the host.
+//!
+//! Boot ([`load`], [`inspect`]) does not run it. A page in a slot was written by [`commit`],
+//! which checked those very bytes (the page CRC keeps them), or flashed by a probe from
+//! what `hil-sim export` wrote, which runs the same check; the check is a pure function of
+//! the page, so at boot it could only repeat its answer. And it would cost: [`load`] runs
+//! before the executor starts, synchronously, on both slots, so it would hold the first
+//! control sample back by up to two sweeps (for Dahl at 20 kHz, 20 001 samples of about
+//! 1 400 cycles, 0.17 s each, and about five times that at the 7 000-cycle bound of a step
+//! with its slow pass) with nothing to yield to; and the read-back in [`commit`], which
+//! goes through [`inspect`], would run it a second time.
 
 use core::sync::atomic::Ordering;
 
 use model_core::control::page::PAGE_BYTES;
-use model_core::control::{ConfigImage, PageError, ValidatedConfig};
+use model_core::control::{ConfigImage, PageError, PhysicsFault, ValidatedConfig};
 use model_core::protocol::Nack;
 
 use super::ports::{Clock, ControlPort, Event, Events, FlashPages};
+use super::time::yield_now;
 use super::App;
 use crate::bringup::{self, BoardMismatch};
 use crate::runner::Loop;
@@ -48,6 +64,59 @@ pub fn runnable(img: &ConfigImage) -> Result<(Loop, ValidatedConfig), PageError>
         BoardMismatch::OverCurrentRange => PageError::Malformed("over_current beyond the comparator"),
     })?;
     Loop::from_image(img).map(|lp| (lp, img.control))
+}
+
+/// Why a page is refused before it is written: it does not make a controller for this
+/// board ([`runnable`]), or its model fails the physics check.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Refusal {
+    Page(PageError),
+    Physics(PhysicsFault),
+}
+
+/// Samples of the physics sweep between two yields to the other tasks. The costliest step
+/// of a built-in model's estimator is below 7 000 cycles (the bound of a control step with
+/// its slow pass, Dahl's and Hammerstein–Wiener's, `hil-sim budget`), so a chunk takes at
+/// most 224 000 cycles: 1.3 ms at 170 MHz, 2.6 ms with the control interrupt's 50 % share,
+/// well inside the watchdog task's 10 ms check and the 50 ms watchdog. A whole sweep is at
+/// most 20 001 samples (626 chunks): for Dahl at its 1 358 cycles 0.16 s (0.32 s with the
+/// interrupt's share), at the 7 000-cycle bound 0.8 s (1.6 s), within the 3 s the host
+/// waits for a commit's reply.
+pub const PHYSICS_CHUNK: u32 = 32;
+
+/// The physics check of a page's model, the whole sweep at once: what the host refuses a
+/// page with (`hil-sim export`, `board load`), the same code [`commit`] runs in chunks.
+pub fn physics(img: &ConfigImage) -> Result<(), Refusal> {
+    let (lp, cfg) = runnable(img).map_err(Refusal::Page)?;
+    let mut sweep = lp.sweep(cfg.get());
+    loop {
+        if let Some(v) = sweep.advance(u32::MAX) {
+            return v.map_err(Refusal::Physics);
+        }
+    }
+}
+
+/// [`physics`], [`PHYSICS_CHUNK`] samples at a time with a yield to the other tasks
+/// between chunks (the watchdog task, the other link and the telemetry keep running).
+pub async fn physics_chunked(img: &ConfigImage) -> Result<(), Refusal> {
+    let (lp, cfg) = runnable(img).map_err(Refusal::Page)?;
+    let mut sweep = lp.sweep(cfg.get());
+    loop {
+        if let Some(v) = sweep.advance(PHYSICS_CHUNK) {
+            return v.map_err(Refusal::Physics);
+        }
+        yield_now().await;
+    }
+}
+
+/// The reply to a page refused before it is written. The protocol has no reason for a
+/// failed physics check yet: it is answered as an invalid page, like a page that does not
+/// build; a dedicated `Nack` reason would be returned here for [`Refusal::Physics`].
+fn refusal_nack(r: Refusal) -> Nack {
+    match r {
+        Refusal::Page(_) => Nack::InvalidPage,
+        Refusal::Physics(_) => Nack::Physics,
+    }
 }
 
 /// A usable slot's controller, its configuration and its page's CRC-32.
@@ -107,9 +176,9 @@ pub fn load(flash: &impl FlashPages, events: &impl Events) -> Result<Loaded, Pag
     Ok(Loaded { lp, cfg, running: None, damaged, crc: 0 })
 }
 
-/// Validate the received page, write it to the slot not running (erase, image, commit
-/// record last; the flash waits yield), read it back, hand the controller built from the
-/// read-back to the control interrupt.
+/// Validate the received page and check its model's physics ([`physics_chunked`]), write
+/// it to the slot not running (erase, image, commit record last; the flash waits yield),
+/// read it back, hand the controller built from the read-back to the control interrupt.
 /// The new (slot, commit).
 pub async fn commit<C: Clock, F: FlashPages, P: ControlPort, E: Events>(
     app: App<'_, C, F, P, E>,
@@ -121,8 +190,9 @@ pub async fn commit<C: Clock, F: FlashPages, P: ControlPort, E: Events>(
         return Err(Nack::Busy);
     }
     // Checked now, built again once written: a controller held across the flash waits
-    // would sit in both link tasks' futures (11 KB each with every model built in).
-    runnable(img).map(drop).map_err(|_| Nack::InvalidPage)?;
+    // would sit in both link tasks' futures (11 KB each with every model built in). The
+    // one the physics sweep runs on is dropped before them.
+    physics_chunked(img).await.map_err(refusal_nack)?;
     let (slot, seq) = slots::commit_target(running);
     let image = slots::slot_image(bytes, seq).ok_or(Nack::InvalidPage)?;
     app.flash.program(slot, &image).await.map_err(|e| {
@@ -270,5 +340,46 @@ mod tests {
         assert_ne!(slot2, slot);
         assert!(slots::newer(seq, seq2), "commit {seq2} is newer than {seq}");
         assert_eq!(load(&flash, &Quiet).expect("boot").running, Some((slot2, seq2)));
+    }
+
+    /// The compiled-in page with its model's stiffness (the first parameter) negated.
+    fn flipped() -> (ConfigImage, [u8; PAGE_BYTES]) {
+        let d = bringup::default_image().expect("default page");
+        let mut p = [0.0f32; 4];
+        p.copy_from_slice(d.params());
+        p[0] = -p[0];
+        let img = ConfigImage::new(d.model_id(), &p, d.rate, d.control).expect("page");
+        (img, img.encode())
+    }
+
+    #[test]
+    fn a_page_whose_estimate_falls_with_the_field_is_refused_before_flash() {
+        let flash = Pages(RefCell::new([[0xFF; SLOT_BYTES]; 2]));
+        let (ctl, shared) = (Ctl::default(), Shared::new(None, false, 0));
+        let app = App { clock: &Now, flash: &flash, ctl: &ctl, events: &Quiet, shared: &shared };
+        let (img, bytes) = flipped();
+        assert!(matches!(physics(&img), Err(Refusal::Physics(PhysicsFault::Decreasing { .. }))));
+        assert!(matches!(block_on(physics_chunked(&img)), Err(Refusal::Physics(PhysicsFault::Decreasing { .. }))));
+        assert_eq!(block_on(commit(app, &bytes, &img, None)), Err(Nack::Physics));
+        assert!(flash.0.borrow().iter().all(|s| slots::is_blank(s)), "nothing written");
+        assert_eq!(ctl.handed.get(), None, "nothing handed to the interrupt");
+        // The compiled-in page passes, at once and in chunks, and still commits and boots.
+        let (good, good_bytes) = page();
+        assert_eq!(physics(&good), Ok(()));
+        assert_eq!(block_on(physics_chunked(&good)), Ok(()));
+        let (slot, seq) = block_on(commit(app, &good_bytes, &good, None)).expect("commit");
+        assert_eq!(inspect(&flash, slot).0, SlotState::Valid(seq), "the stored page boots");
+    }
+
+    #[test]
+    fn the_chunked_check_yields_between_chunks() {
+        let (img, _) = page();
+        let mut f = pin!(physics_chunked(&img));
+        let mut polls = 0u32;
+        while f.as_mut().poll(&mut Context::from_waker(Waker::noop())).is_pending() {
+            polls += 1;
+        }
+        // 20 001 samples at 20 kHz in chunks of PHYSICS_CHUNK: one yield after each but the last.
+        assert_eq!(polls, 20_001u32.div_ceil(PHYSICS_CHUNK) - 1);
     }
 }

@@ -1,4 +1,4 @@
-//! Periodic wake-ups and timeouts on a [`Clock`].
+//! Periodic wake-ups and timeouts on a [`Clock`], and a yield to the other tasks.
 
 use core::future::Future;
 
@@ -37,4 +37,12 @@ pub async fn with_timeout<F: Future>(clock: &impl Clock, timeout_us: u64, fut: F
 /// Wait `us`.
 pub async fn after(clock: &impl Clock, us: u64) {
     clock.at(clock.now_us() + us).await;
+}
+
+/// Let the executor run the other tasks once, then go on: what a long computation awaits
+/// between chunks so the watchdog task, the other link and the telemetry keep running. A
+/// wait on the [`Clock`] cannot stand in for it: one already due (`after(clock, 0)`)
+/// resolves at its first poll without giving the executor back.
+pub async fn yield_now() {
+    embassy_futures::yield_now().await;
 }

@@ -2,14 +2,18 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context;
+use anyhow::{bail, Context};
 use clap::{Args, Subcommand};
-use hil_sim::link::{load, record, Link};
-use model_core::control::FaultCode;
-use model_core::protocol::Command;
+use hil_sim::link::client::{fault_name, mode_name};
+use hil_sim::link::{load, record, Link, LinkError};
+use model_core::protocol::{quantise_reference, Command, Nack};
 use serde_json::json;
 
 use super::progress::Bar;
+
+/// A reset is answered once the fault checks have had their samples: up to 50 ms on the
+/// board, plus the line.
+const RESET_REPLY: std::time::Duration = std::time::Duration::from_millis(500);
 
 #[derive(Args, Debug)]
 pub struct BoardArgs {
@@ -27,13 +31,14 @@ pub struct BoardArgs {
 pub enum Action {
     /// Mode, latched fault, overruns, torque estimate.
     Status,
-    /// Bridge on (the board releases it again after 100 ms without a command).
+    /// Bridge on (the board releases it again after 100 ms without a command from this
+    /// host; refused while a fault is latched).
     Enable,
     /// Bridge off.
     Disable,
-    /// Clear a latched fault (the loop recalibrates).
+    /// Clear a latched fault (the loop recalibrates); fails if the fault is still present.
     Reset,
-    /// Set the torque reference, N·m.
+    /// Set the torque reference, N·m (within the running page's limit; 1 mN·m steps).
     Torque {
         #[arg(allow_negative_numbers = true)]
         value: f32,
@@ -58,16 +63,35 @@ pub enum Action {
     },
 }
 
-fn fault_name(code: u8) -> &'static str {
-    FaultCode::ALL.iter().find(|f| f.code() == code).map_or("unknown", |f| f.name())
-}
-
 fn ok(json: bool, what: &str) -> anyhow::Result<()> {
     if json {
         super::print_json(&json!({ "ok": true }))
     } else {
         super::emit(&format!("ok: {what}\n"));
         Ok(())
+    }
+}
+
+/// A refusal that names the fault it is about (read from the board's status).
+fn with_fault(link: &mut Link, e: LinkError) -> anyhow::Error {
+    match &e {
+        LinkError::Refused { reason: Nack::Faulted | Nack::FaultPresent, .. } => match link.status() {
+            Ok(s) => anyhow::anyhow!("{e}: latched fault {} (code {})", fault_name(s.fault), s.fault),
+            Err(_) => e.into(),
+        },
+        _ => e.into(),
+    }
+}
+
+/// A reference within the running page's limit, as the frame carries it.
+fn checked_reference(link: &mut Link, value: f32) -> anyhow::Result<f32> {
+    let limits = link.limits()?;
+    match quantise_reference(value) {
+        Some(v) if v.abs() <= limits.reference_max => Ok(v),
+        _ => bail!(
+            "torque {value:?}: beyond the running page's limit of ±{} N·m (its torque_max); nothing was sent",
+            limits.reference_max
+        ),
     }
 }
 
@@ -78,15 +102,18 @@ pub fn run(a: BoardArgs) -> anyhow::Result<()> {
             let s = link.status()?;
             if a.json {
                 super::print_json(&json!({
-                    "mode": s.mode, "fault": s.fault, "fault_name": fault_name(s.fault),
+                    "mode": s.mode, "mode_name": mode_name(s.mode), "fault": s.fault, "fault_name": fault_name(s.fault),
                     "overruns": s.overruns, "torque_estimate": s.torque_estimate,
                 }))
             } else {
                 super::emit(&format!(
-                    "mode {} | fault {} ({}) | overruns {} | torque estimate {:.3} N·m\n",
-                    s.mode,
-                    s.fault,
-                    fault_name(s.fault),
+                    "mode {} | fault {} | overruns {} | torque estimate {:.3} N·m\n",
+                    mode_name(s.mode),
+                    if s.fault == 0 {
+                        "none".to_owned()
+                    } else {
+                        format!("{} (code {})", fault_name(s.fault), s.fault)
+                    },
                     s.overruns,
                     s.torque_estimate
                 ));
@@ -94,25 +121,23 @@ pub fn run(a: BoardArgs) -> anyhow::Result<()> {
             }
         }
         Action::Enable => {
-            link.ack(Command::Enable(true), "enable")?;
+            let r = link.command(|guard| Command::Enable { guard, on: true }, "enable");
+            r.map_err(|e| with_fault(&mut link, e))?;
             ok(a.json, "bridge enabled")
         }
         Action::Disable => {
-            link.ack(Command::Enable(false), "disable")?;
+            link.command(|guard| Command::Enable { guard, on: false }, "disable")?;
             ok(a.json, "bridge off")
         }
         Action::Reset => {
-            link.ack(Command::Reset, "reset")?;
+            let r = link.command_waiting(|guard| Command::Reset { guard }, "reset", RESET_REPLY);
+            r.map_err(|e| with_fault(&mut link, e))?;
             ok(a.json, "fault cleared")
         }
         Action::Torque { value } => {
-            if !value.is_finite() {
-                anyhow::bail!("torque: {value} is not a number");
-            }
-            link.send(Command::SetTorque(value))?;
-            // Not acknowledged by the protocol; a status request confirms the board heard.
-            link.status()?;
-            ok(a.json, &format!("torque reference {value} N·m"))
+            let v = checked_reference(&mut link, value)?;
+            link.command(|guard| Command::SetTorque { guard, reference: v, ack: true }, "the torque reference")?;
+            ok(a.json, &format!("torque reference {v} N·m"))
         }
         Action::Load { params } => {
             let path = super::file_arg(&params)?;
@@ -133,31 +158,44 @@ pub fn run(a: BoardArgs) -> anyhow::Result<()> {
             }
         }
         Action::Record { seconds, out, profile, decimate, enable } => {
-            if !(seconds.is_finite() && seconds > 0.0) {
-                anyhow::bail!("--seconds {seconds}: expected a positive number of seconds");
+            // The profile is read first: it is an input, which no output may overwrite.
+            let profile = profile.map(|p| record::read_profile(&p).map(|rows| (p, rows))).transpose()?;
+            record::check_request(seconds, decimate, &out)?;
+            if let Some((p, rows)) = &profile {
+                record::check_profile(p, rows, &link.limits()?)?;
             }
-            let profile = profile.map(|p| record::read_profile(&p)).transpose()?;
+            let profile = profile.map(|(_, rows)| rows);
             if enable {
-                link.ack(Command::Enable(true), "enable")?;
+                link.command(|guard| Command::Enable { guard, on: true }, "enable")
+                    .map_err(|e| with_fault(&mut link, e))?;
             }
             let bar = Bar::new(0, "record");
-            let r = record::record(&mut link, seconds, &out, profile.as_deref(), decimate, &bar);
+            let plan = record::Plan {
+                seconds,
+                out: &out,
+                profile: profile.as_deref(),
+                decimation: decimate,
+                driving: enable || profile.is_some(),
+            };
+            let r = record::record(&mut link, &plan, &bar);
             bar.finish();
             if enable {
-                link.ack(Command::Enable(false), "disable").context("after the recording")?;
+                link.command(|guard| Command::Enable { guard, on: false }, "disable").context("after the recording")?;
             }
             let r = r?;
             if a.json {
                 super::print_json(&json!({
                     "samples": r.samples, "file": r.file, "lost_frames": r.lost, "crc_errors": r.crc_errors,
+                    "out_of_order": r.out_of_order,
                 }))
             } else {
                 super::emit(&format!(
-                    "{}: {} samples ({} telemetry frames lost, {} dropped for a bad CRC)\n",
+                    "{}: {} samples ({} telemetry frames lost, {} dropped for a bad CRC, {} out of order)\n",
                     r.file.display(),
                     r.samples,
                     r.lost,
-                    r.crc_errors
+                    r.crc_errors,
+                    r.out_of_order
                 ));
                 Ok(())
             }

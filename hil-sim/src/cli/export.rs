@@ -38,6 +38,9 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
     }
     let (control_hz, control) = config_page::firmware_control(&file.model, a.control_hz)?;
     let img = config_page::firmware_image(&file, &path, control)?;
+    // The board's physics check of the page (and the set's channels): a page it would
+    // refuse is not written.
+    hil_sim::io::page_physics::check(&file, &path, &img)?;
     let bytes = img.encode();
     hil_sim::io::output::write(&a.out, bytes)?;
     let len = u16::from_le_bytes([bytes[6], bytes[7]]);

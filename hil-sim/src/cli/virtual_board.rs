@@ -54,7 +54,9 @@ pub fn run(a: VirtualBoardArgs) -> anyhow::Result<()> {
         None => (ClutchParams::default(), 1),
     };
     let journal: hil_sim::virtual_board::Journal = match &a.journal {
-        Some(p) => Some(Box::new(std::fs::File::create(p).with_context(|| format!("--journal {}", p.display()))?)),
+        Some(p) => {
+            Some(Box::new(hil_sim::io::output::create_stream(p).with_context(|| format!("--journal {}", p.display()))?))
+        }
         None => None,
     };
     if let Some(t) = a.stall_tasks.filter(|t| !(t.is_finite() && *t >= 0.0)) {

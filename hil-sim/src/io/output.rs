@@ -69,6 +69,23 @@ pub fn create_dir(dir: &Path) -> Result<(), OutputError> {
     std::fs::create_dir_all(dir).map_err(|source| OutputError::Io { path: dir.into(), source })
 }
 
+/// A file written as it goes (a journal, a log), not swapped in whole: refused as
+/// [`check`] refuses, its folder made, opened without following a symbolic link put there
+/// after the check.
+pub fn create_stream(path: &Path) -> Result<std::fs::File, OutputError> {
+    check(path)?;
+    let dir = path.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    create_dir(dir)?;
+    let mut o = std::fs::OpenOptions::new();
+    o.write(true).create(true).truncate(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        o.custom_flags(libc::O_NOFOLLOW);
+    }
+    o.open(path).map_err(|source| OutputError::Io { path: path.into(), source })
+}
+
 /// Write `bytes` to `path` (its folder created if missing), through a temporary file.
 pub fn write(path: &Path, bytes: impl AsRef<[u8]>) -> Result<(), OutputError> {
     write_with(path, |w| w.write_all(bytes.as_ref()))

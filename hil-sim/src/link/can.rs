@@ -134,7 +134,9 @@ mod tests {
     fn a_client_frame_goes_out_as_the_command_bytes_the_firmware_decodes() {
         let mut c = CanCodec::default();
         let mut cmd = [0u8; FRAME];
-        let n = Command::SetTorque(6.5).encode(&mut cmd);
+        let guard = model_core::protocol::Guard { session: 2, seq: 9, deadline_ms: 1234 };
+        let set = Command::SetTorque { guard, reference: 6.5, ack: true };
+        let n = set.encode(&mut cmd);
         let mut bytes = framed(&cmd[..n]);
         bytes.extend(framed(&[0xEE; 12])); // too long for CAN: dropped
         let mut damaged = framed(&cmd[..n]);
@@ -142,13 +144,14 @@ mod tests {
         bytes.extend(damaged);
         let out = c.outgoing(&bytes);
         assert_eq!(out, vec![cmd[..n].to_vec()]);
-        assert_eq!(Command::decode(&out[0]), Ok(Command::SetTorque(6.5)));
+        assert_eq!(Command::decode(&out[0]), Ok(set), "a guarded command fits one classic frame");
     }
 
     #[test]
     fn the_firmware_reply_comes_back_as_a_client_frame() {
         let mut c = CanCodec::default();
-        let f = reply(Response::Ack(3)).expect("reply frame");
+        let ack = Response::Ack { code: 3, tag: 0x2009, now_ms: 1200 };
+        let f = reply(ack).expect("reply frame");
         assert!(!c.incoming(ID_CMD, f.data()), "a frame from another id is not a reply");
         assert!(c.incoming(f.id, f.data()));
         let mut buf = [0u8; 64];
@@ -161,7 +164,7 @@ mod tests {
             }
         }
         assert_eq!(got.len(), 1);
-        assert_eq!(Response::decode(&got[0]), Some(Response::Ack(3)));
+        assert_eq!(Response::decode(&got[0]), Some(ack));
         assert!(!c.has_inbound());
     }
 }

@@ -58,6 +58,11 @@ impl VirtualBoard {
         self.rig.set_dt(f64::from(cfg.get().dt));
     }
 
+    /// The configuration that runs and its control rate (the limits the links answer).
+    pub fn running(&self) -> (ValidatedConfig, u32) {
+        (self.cfg, self.lp.control_hz())
+    }
+
     /// Samples run.
     pub fn samples(&self) -> usize {
         self.rig.samples()

@@ -22,6 +22,8 @@ use firmware::application::{self, store, App, Clock, Shared};
 use firmware::bringup::ResetCause;
 use thiserror::Error;
 
+use model_core::protocol::frame::{encode, Deframer, MAX_ENCODED};
+
 use super::board::{Journal, VirtualBoard};
 use super::ports::{expired, PipeRx, PipeTx, SimClock, SimControl, SimFlash, SimWatchdog, Stderr};
 use crate::closed_loop::Schedule;
@@ -64,50 +66,102 @@ fn poll_once<F: Future>(f: Pin<&mut F>) -> Option<F::Output> {
     }
 }
 
-/// The host side of the UART: the listener, the connected host, bytes in both directions.
+/// Hosts connected at once; a further connection is closed at once.
+const CLIENTS: usize = 4;
+/// A host that has sent nothing for this long is disconnected, s (its slot freed).
+const CLIENT_IDLE: Duration = Duration::from_secs(30);
+
+/// One connected host: its socket, its own deframer (its frames reach the board whole,
+/// never interleaved with another host's bytes), when it last sent anything.
+struct Client {
+    stream: TcpStream,
+    deframer: Deframer,
+    heard: Instant,
+}
+
+/// The host side of the UART: the listener, the connected hosts, bytes in both directions.
+/// Every host's whole frames go to the board's receive buffer, stamped with the wall-clock
+/// time they arrived: the board takes them no earlier in its own time (a simulation that
+/// runs behind real time sees a command as late as it really is); the board's bytes go to
+/// every host (a shared line: each host matches the replies to its own commands).
 struct Net {
     listener: TcpListener,
-    client: RefCell<Option<TcpStream>>,
-    /// Host → board (the UART's receive buffer) and board → host.
+    clients: RefCell<Vec<Client>>,
+    /// Host → board: frames waiting for their arrival time (µs since the start), then the
+    /// UART's receive buffer; board → host.
+    arriving: RefCell<VecDeque<(u64, Vec<u8>)>>,
     rx: RefCell<VecDeque<u8>>,
     tx: RefCell<Vec<u8>>,
+    start: Instant,
 }
 
 impl Net {
-    /// Accept a host if none is connected; move what it sent into `rx`.
+    /// Accept new hosts; take what each sent; drop the silent and the gone.
     fn receive(&self) -> Result<(), ServeError> {
-        let mut client = self.client.borrow_mut();
-        if client.is_none() {
-            if let Ok((s, _)) = self.listener.accept() {
-                s.set_nonblocking(true)?;
-                s.set_nodelay(true)?;
-                *client = Some(s);
+        let mut clients = self.clients.borrow_mut();
+        while let Ok((s, peer)) = self.listener.accept() {
+            if clients.len() >= CLIENTS {
+                eprintln!("virtual board: {peer}: {CLIENTS} hosts connected already; closing the connection");
+                continue;
             }
+            s.set_nonblocking(true)?;
+            s.set_nodelay(true)?;
+            clients.push(Client { stream: s, deframer: Deframer::default(), heard: Instant::now() });
         }
+        let now_us = self.start.elapsed().as_micros() as u64;
         let mut buf = [0u8; 4096];
-        if let Some(s) = client.as_mut() {
-            match s.read(&mut buf) {
-                Ok(0) => *client = None,
-                Ok(n) => self.rx.borrow_mut().extend(&buf[..n]),
-                Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::Interrupted) => {}
-                Err(_) => *client = None,
+        clients.retain_mut(|c| {
+            let mut open = true;
+            loop {
+                match c.stream.read(&mut buf) {
+                    Ok(0) => open = false,
+                    Ok(n) => {
+                        c.heard = Instant::now();
+                        for &b in &buf[..n] {
+                            if let Some(Ok(p)) = c.deframer.push(b) {
+                                let mut e = [0u8; MAX_ENCODED];
+                                let k = encode(p, &mut e);
+                                self.arriving.borrow_mut().push_back((now_us, e[..k].to_vec()));
+                            }
+                        }
+                        continue;
+                    }
+                    Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+                    Err(e) if e.kind() == ErrorKind::WouldBlock => {}
+                    Err(_) => open = false,
+                }
+                break;
             }
-        }
+            if open && c.heard.elapsed() > CLIENT_IDLE {
+                eprintln!("virtual board: a host silent for {} s disconnected", CLIENT_IDLE.as_secs());
+                open = false;
+            }
+            open
+        });
         Ok(())
     }
 
-    /// Send what the board wrote; with no host it is lost (the UART's line is idle).
-    fn send(&self) {
-        let out = std::mem::take(&mut *self.tx.borrow_mut());
-        let mut client = self.client.borrow_mut();
-        if let (Some(s), false) = (client.as_mut(), out.is_empty()) {
-            // A host that does not read loses frames (a UART's full transmit buffer).
-            if let Err(e) = s.write(&out) {
-                if e.kind() != ErrorKind::WouldBlock {
-                    *client = None;
-                }
+    /// Frames that have arrived by board time `board_us` into the UART's receive buffer.
+    fn deliver(&self, board_us: u64) {
+        let mut arriving = self.arriving.borrow_mut();
+        while arriving.front().is_some_and(|(at, _)| *at <= board_us) {
+            if let Some((_, f)) = arriving.pop_front() {
+                self.rx.borrow_mut().extend(f);
             }
         }
+    }
+
+    /// Send what the board wrote to every host; with none it is lost (the line is idle).
+    fn send(&self) {
+        let out = std::mem::take(&mut *self.tx.borrow_mut());
+        if out.is_empty() {
+            return;
+        }
+        self.clients.borrow_mut().retain_mut(|c| match c.stream.write(&out) {
+            Ok(_) => true,
+            // A host that does not read loses frames (a UART's full transmit buffer).
+            Err(e) => e.kind() == ErrorKind::WouldBlock,
+        });
     }
 }
 
@@ -121,12 +175,19 @@ pub fn serve(opts: ServeOptions, ready: &mut dyn FnMut(SocketAddr)) -> Result<()
     let boot = store::load(&flash, &Stderr).map_err(ServeError::Page)?;
     let mut booted = (boot.running, boot.damaged, boot.crc);
     let mut board = VirtualBoard::new(&opts.clutch, opts.seed, opts.fault, opts.journal, boot.lp, boot.cfg);
-    let net = Net { listener, client: RefCell::new(None), rx: RefCell::default(), tx: RefCell::default() };
-    ready(net.listener.local_addr()?);
     let start = Instant::now();
+    let net = Net {
+        listener,
+        clients: RefCell::default(),
+        arriving: RefCell::default(),
+        rx: RefCell::default(),
+        tx: RefCell::default(),
+        start,
+    };
+    ready(net.listener.local_addr()?);
     let mut stall_us = opts.stall_tasks.map(|s| (s * 1e6).round() as u64);
     loop {
-        run_boot(&clock, &flash, &mut board, &net, booted, start, stall_us.take())?;
+        run_boot(&clock, &flash, &mut board, &net, booted, stall_us.take())?;
         eprintln!(
             "virtual board: watchdog reset at {:.4} s; starting again, reset cause {:?}",
             clock.now_us() as f64 * 1e-6,
@@ -146,11 +207,12 @@ fn run_boot(
     board: &mut VirtualBoard,
     net: &Net,
     (running, damaged, crc): (Option<(firmware::slots::Slot, u32)>, bool, u32),
-    start: Instant,
     stall_us: Option<u64>,
 ) -> Result<(), ServeError> {
     let ctl = SimControl::new(running, damaged);
     let shared = Shared::new(running, damaged, crc);
+    let (cfg, hz) = board.running();
+    shared.set_limits(&cfg, hz);
     let last_pet = Cell::new(None);
     let mut wd = SimWatchdog::new(clock, &last_pet);
     let app = App { clock, flash, ctl: &ctl, events: &Stderr, shared: &shared };
@@ -164,10 +226,11 @@ fn run_boot(
     loop {
         net.receive()?;
         // Simulated real time: every sample whose time has come on the wall clock.
-        let due_us = start.elapsed().as_micros() as u64;
+        let due_us = net.start.elapsed().as_micros() as u64;
         let mut ran = 0;
         while board.time_us() <= due_us && ran < BURST {
             clock.set(board.time_us());
+            net.deliver(board.time_us());
             // The tasks never end (`-> !`); polled before every sample.
             if stall_us.is_none_or(|t| clock.now_us() < t) {
                 let _ = poll_once(tasks.as_mut());

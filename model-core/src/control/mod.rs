@@ -18,12 +18,14 @@
 //! per-sample step trips if that pass stalls.
 //! Settings are a [`config::ValidatedConfig`]: validated once, CRC-protected, swapped in
 //! between samples by replacing a `Copy` value. The flash page that holds the model, its
-//! parameters and these settings is [`page`].
+//! parameters and these settings is [`page`]; [`physics`] checks a page's model on a slow
+//! sweep of the field before the page is committed.
 
 pub mod calibration;
 pub mod config;
 pub mod feedforward;
 pub mod page;
+pub mod physics;
 pub mod pi;
 pub mod pwm;
 pub mod step;
@@ -31,5 +33,6 @@ pub mod supervisor;
 
 pub use config::{ControlConfig, LoopMode, ValidatedConfig};
 pub use page::{ConfigImage, PageError, RateSpec};
+pub use physics::PhysicsFault;
 pub use step::{ControlInput, ControlOutput, ControlState, ControlStep, Mode};
 pub use supervisor::FaultCode;

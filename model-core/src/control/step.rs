@@ -341,6 +341,16 @@ impl<M: Model> ControlStep<M> {
         if early != FaultCode::None && !matches!(s.mode, Mode::Fault(_)) {
             return trip(s, b, i, early);
         }
+        if matches!(s.mode, Mode::Init | Mode::Disabled) {
+            // The sensor and supply checks watch the board whether or not the bridge is
+            // on: a Hall wire that opens, a coil current where none can flow, a supply out
+            // of its window are latched while the clutch idles, not when it is next driven.
+            // (An overrun or a held estimate means nothing while nothing is driven.)
+            let f = Fast { hall: x.hall, i, supply_v: x.supply_v, overrun: false, model_bad: false };
+            if confirm(k, &mut s.sup, fast_any(k, &f)) {
+                return trip(s, b, i, supervisor::fast_code_inline(k, &f));
+            }
+        }
         let mode = match s.mode {
             Mode::Fault(code) => {
                 if x.reset {

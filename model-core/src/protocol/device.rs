@@ -1,27 +1,78 @@
 //! The board's command handling as pure code, shared by the firmware's link tasks and
 //! `hil-sim virtual-board`: a frame in, an [`Action`] for the application and the reply
-//! out; the configuration page assembled here; telemetry decimated and numbered here.
-//! Committing a page (flash) is the caller's: [`Action::Commit`] hands it the checked page.
+//! out; the session and guard checks ([`super::session`]) made here, the configuration
+//! page assembled here, telemetry decimated and numbered here. Committing a page (flash)
+//! is the caller's: [`Action::Commit`] hands it the checked page.
 
+use super::session::{clock16, Sessions};
 use super::{Command, Nack, PageAssembler, Response};
 use crate::control::page::{ConfigImage, PAGE_BYTES};
 
-/// What the application must do for a frame.
+/// Whom a reply answers: the command byte, its guard's tag (0 unguarded), the board's
+/// clock when it was handled.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Reply {
+    pub code: u8,
+    pub tag: u16,
+    pub now_ms: u16,
+}
+
+impl Reply {
+    pub const fn ack(self) -> Response {
+        Response::Ack { code: self.code, tag: self.tag, now_ms: self.now_ms }
+    }
+    pub const fn nack(self, why: Nack) -> Response {
+        Response::Nack { code: self.code, why, tag: self.tag, now_ms: self.now_ms }
+    }
+    pub const fn result(self, r: Result<(), Nack>) -> Response {
+        match r {
+            Ok(()) => self.ack(),
+            Err(why) => self.nack(why),
+        }
+    }
+}
+
+/// What the application must do for a frame. Where a [`Reply`] is given, the reply is the
+/// application's to send once it has done (or refused) the action.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Action {
     /// Nothing beyond the reply.
     None,
-    /// New torque reference, N·m.
-    Reference(f32),
+    /// New torque reference, N·m (A in current mode); `reply` for the acknowledged form.
+    Reference { value: f32, reply: Option<Reply> },
     /// Bridge on/off.
-    Enable(bool),
+    Enable { on: bool, reply: Reply },
     /// Clear a latched fault.
-    Reset,
+    Reset { reply: Reply },
     /// Answer with [`Device::status`] (the application fills in its figures).
     Status,
+    /// Answer with the running page's limits.
+    Limits,
     /// Store this page (transfer CRC and decode already checked, bridge off), then answer
     /// with [`Device::committed`].
     Commit,
+    /// The session ended (released by its holder): drive off, reference zero, then the reply.
+    Released { reply: Reply },
+}
+
+/// A frame handled.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Handled {
+    pub action: Action,
+    /// The reply to send at once (none when the action owes it, or for a streamed command).
+    pub reply: Option<Response>,
+    /// A guarded command of the session was admitted: its holder was heard (the drive's
+    /// command timeout counts from here).
+    pub heard: bool,
+}
+
+impl Handled {
+    const fn reply(r: Response) -> Self {
+        Self { action: Action::None, reply: Some(r), heard: false }
+    }
+    const fn act(action: Action) -> Self {
+        Self { action, reply: None, heard: true }
+    }
 }
 
 /// The figures a status reply carries.
@@ -37,6 +88,8 @@ pub struct StatusFigures {
 #[derive(Clone, Debug, Default)]
 pub struct Device {
     page: PageAssembler,
+    /// The session whose guarded begin opened the transfer in `page`.
+    transfer: Option<u8>,
     enabled: bool,
     pending: Option<ConfigImage>,
     /// Every `decimation`-th sample is streamed (0: off).
@@ -56,47 +109,77 @@ impl Device {
         Self { active_crc, ..Self::default() }
     }
 
-    /// Handle one decoded frame's bytes: the action and, when the frame is answered at once,
-    /// the reply.
-    pub fn handle(&mut self, frame: &[u8]) -> (Action, Option<Response>) {
+    /// Handle one decoded frame's bytes at `now_ms` (the board's clock) with the board's
+    /// `sessions`: the action, the reply when it is sent at once, whether the session's
+    /// holder was heard.
+    pub fn handle(&mut self, frame: &[u8], now_ms: u64, sessions: &mut Sessions) -> Handled {
         let code = frame.first().copied().unwrap_or(0);
+        let now16 = clock16(now_ms);
         let cmd = match Command::decode(frame) {
             Ok(c) => c,
-            Err(why) => return (Action::None, Some(Response::Nack(code, why))),
+            Err(why) => return Handled::reply(Reply { code, tag: 0, now_ms: now16 }.nack(why)),
         };
-        let ack = Some(Response::Ack(code));
-        match cmd {
-            Command::SetTorque(t) => (Action::Reference(t), None),
-            Command::Enable(e) => {
-                self.enabled = e;
-                (Action::Enable(e), ack)
+        let r = Reply { code, tag: cmd.guard().map_or(0, |g| g.tag()), now_ms: now16 };
+        if let Some(g) = cmd.guard() {
+            if let Err(why) = sessions.admit(g, now_ms) {
+                return Handled::reply(r.nack(why));
             }
-            Command::Reset => (Action::Reset, ack),
-            Command::GetStatus => (Action::Status, None),
-            Command::ConfigQuery => (Action::None, Some(Response::PageCrc(self.active_crc))),
+        }
+        match cmd {
+            Command::SetTorque { reference, ack, .. } => {
+                Handled::act(Action::Reference { value: reference, reply: ack.then_some(r) })
+            }
+            Command::Enable { on, .. } => {
+                self.enabled = on;
+                Handled::act(Action::Enable { on, reply: r })
+            }
+            Command::Reset { .. } => Handled::act(Action::Reset { reply: r }),
+            Command::Heartbeat { .. } => Handled::act(Action::None),
+            Command::Release { .. } => {
+                let _ = sessions.release();
+                self.released();
+                Handled::act(Action::Released { reply: r })
+            }
+            Command::Claim { nonce } => Handled::reply(match sessions.claim(nonce, now_ms) {
+                Ok(tag) => Response::Session { nonce, tag, now_ms: now16 },
+                Err(why) => r.nack(why),
+            }),
+            Command::GetStatus => Handled { action: Action::Status, reply: None, heard: false },
+            Command::Limits => Handled { action: Action::Limits, reply: None, heard: false },
+            Command::ConfigQuery => Handled::reply(Response::PageCrc(self.active_crc)),
             Command::Telemetry { decimation } => {
                 self.decimation = decimation;
                 self.count = 0;
-                (Action::None, ack)
+                Handled::reply(r.ack())
             }
-            Command::ConfigBegin { len } => (Action::None, Some(reply(code, self.page.begin(len)))),
+            Command::ConfigBegin { guard, len } => {
+                let begun = self.page.begin(len);
+                self.transfer = begun.is_ok().then_some(guard.session);
+                Handled { action: Action::None, reply: Some(r.result(begun)), heard: true }
+            }
             Command::ConfigData { offset, len, data } => {
-                let r = self.page.data(offset, data.get(..usize::from(len)).unwrap_or(&[]));
-                (Action::None, r.err().map(|why| Response::Nack(code, why)))
+                let res = self.page.data(offset, data.get(..usize::from(len)).unwrap_or(&[]));
+                Handled { action: Action::None, reply: res.err().map(|why| r.nack(why)), heard: false }
             }
-            Command::ConfigCommit { crc } => {
-                if self.enabled {
-                    return (Action::None, Some(Response::Nack(code, Nack::Busy)));
-                }
-                match self.page.commit(crc) {
-                    Ok((_, img)) => {
-                        self.pending = Some(img);
-                        (Action::Commit, None)
-                    }
-                    Err(why) => (Action::None, Some(Response::Nack(code, why))),
-                }
-            }
+            Command::ConfigCommit { crc } => match self.commit(crc, sessions) {
+                Ok(()) => Handled { action: Action::Commit, reply: None, heard: false },
+                Err(why) => Handled::reply(r.nack(why)),
+            },
         }
+    }
+
+    /// A commit of the transfer: its session still held, the bridge off, the bytes whole.
+    fn commit(&mut self, crc: u32, sessions: &Sessions) -> Result<(), Nack> {
+        if self.transfer.is_none_or(|s| !sessions.holds(s)) {
+            self.transfer = None;
+            return Err(Nack::NoSession);
+        }
+        if self.enabled {
+            return Err(Nack::Busy);
+        }
+        let (_, img) = self.page.commit(crc)?;
+        self.pending = Some(img);
+        Ok(())
     }
 
     /// The decoded page of the last [`Action::Commit`], until taken.
@@ -120,8 +203,8 @@ impl Device {
     }
 
     /// The reply to a commit once the caller stored (or failed to store) the page.
-    pub fn committed(&self, result: Result<(), Nack>) -> Response {
-        reply(0x12, result)
+    pub fn committed(&self, result: Result<(), Nack>, now_ms: u64) -> Response {
+        Reply { code: 0x12, tag: 0, now_ms: clock16(now_ms) }.result(result)
     }
 
     /// The status reply.
@@ -157,12 +240,5 @@ impl Device {
         let s = self.seq;
         self.seq = self.seq.wrapping_add(1);
         s
-    }
-}
-
-fn reply(code: u8, r: Result<(), Nack>) -> Response {
-    match r {
-        Ok(()) => Response::Ack(code),
-        Err(why) => Response::Nack(code, why),
     }
 }

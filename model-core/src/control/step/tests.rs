@@ -77,6 +77,28 @@ fn fault_latches_until_reset() {
 }
 
 #[test]
+fn sensor_and_supply_faults_latch_with_the_bridge_off() {
+    let (step, cfg) = setup(LoopMode::Torque);
+    let off = |hall, supply| ControlInput { enable: false, ..ControlInput::new(hall, 2048, supply, 0.0) };
+    for (x, code) in [(off(4095, 24.0), FaultCode::HallOpen), (off(2048, 3.0), FaultCode::SupplyLow)] {
+        let mut s = step.state();
+        for _ in 0..5 {
+            let o = tick(&step, &cfg, &mut s, off(2048, 24.0));
+            assert_eq!((o.mode, o.fault), (Mode::Disabled, FaultCode::None), "idle and well");
+        }
+        let confirm = cfg.get().confirm_samples as usize;
+        for _ in 1..confirm {
+            assert_eq!(tick(&step, &cfg, &mut s, x).fault, FaultCode::None, "confirmed over {confirm} samples");
+        }
+        let o = tick(&step, &cfg, &mut s, x);
+        assert_eq!((o.mode, o.fault, o.pwm_enable), (Mode::Fault(code), code, false), "{x:?}");
+        // Latched: the sensor back to normal, enable asked for, still the fault until reset.
+        let o = tick(&step, &cfg, &mut s, ControlInput::new(2048, 2048, 24.0, 1.0));
+        assert_eq!(o.fault, code, "latched");
+    }
+}
+
+#[test]
 fn the_loop_waits_for_a_slow_pass_and_trips_when_it_stalls() {
     let (step, cfg) = setup(LoopMode::Current);
     let mut s = step.state();
