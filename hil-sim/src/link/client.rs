@@ -277,13 +277,16 @@ impl Link {
             Response::Ack { now_ms, .. } | Response::Session { now_ms, .. } => {
                 self.clock = Some(BoardClock { ms: now_ms, at: Instant::now() });
             }
-            Response::Nack { now_ms, why, code, .. } => {
+            Response::Nack { now_ms, why, code, tag } => {
                 self.clock = Some(BoardClock { ms: now_ms, at: Instant::now() });
-                if matches!(code, 0x01 | 0x08) {
+                // On a shared line (the virtual board's other hosts) a nack may answer
+                // another host's command: only this session's count.
+                let ours = self.session.is_some_and(|h| Guard::from_tag(tag, 0).session == h.last.session);
+                if ours && matches!(code, 0x01 | 0x08) {
                     self.stats.refused += 1;
                     self.stats.last_refusal = Some(why);
                 }
-                if why == Nack::NoSession {
+                if ours && why == Nack::NoSession {
                     self.session = None;
                 }
             }
