@@ -151,7 +151,13 @@ impl Drop for ScriptedBoard {
 
 impl ScriptedBoard {
     /// Serve one host at a time with `script`; status and page-CRC answers as given.
-    pub fn start(mut script: impl Script, page_crc: u32) -> Self {
+    pub fn start(script: impl Script, page_crc: u32) -> Self {
+        Self::with_clock(script, page_crc, 1.0)
+    }
+
+    /// [`ScriptedBoard::start`] with a board clock that runs `rate` times real time (a
+    /// crystal off its frequency).
+    pub fn with_clock(mut script: impl Script, page_crc: u32, rate: f64) -> Self {
         let listener = TcpListener::bind("127.0.0.1:0").expect("bind");
         listener.set_nonblocking(true).expect("nonblocking");
         let port = format!("tcp:{}", listener.local_addr().expect("addr"));
@@ -179,7 +185,7 @@ impl ScriptedBoard {
                                 for &b in &buf[..k] {
                                     let Some(Ok(p)) = deframer.push(b) else { continue };
                                     let p = p.to_vec();
-                                    let now_ms = start.elapsed().as_millis() as u64;
+                                    let now_ms = (start.elapsed().as_secs_f64() * 1e3 * rate) as u64;
                                     let cmd = Command::decode(&p);
                                     if let Ok(Command::Telemetry { decimation }) = cmd {
                                         streaming = decimation != 0;

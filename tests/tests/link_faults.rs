@@ -456,3 +456,19 @@ fn a_page_that_would_drive_the_clutch_wrongly_never_reaches_the_loop() {
     let pages: Vec<_> = journal(&dir.join("j.txt")).into_iter().filter(|e| e.1 == "page").collect();
     assert_eq!(pages.len(), 1, "only the clutch set reached the loop: {pages:?}");
 }
+
+#[test]
+fn deadlines_follow_a_board_clock_that_runs_fast_over_a_long_driven_recording() {
+    let bin = hil_sim();
+    let dir = scratch("drift");
+    // A board clock 5 % fast: without reading it again the host's deadlines would fall
+    // behind it by more than a set-point's 100 ms lead within 2 s.
+    let board = ScriptedBoard::with_clock(Frames(|n| tele(n as u16, (n as u32) * 500)), 0, 1.05);
+    std::fs::write(dir.join("p.csv"), "t,reference\n0,1\n4,2\n").expect("profile");
+    let rec = json(
+        &bin,
+        &dir,
+        &["board", "--port", &board.port, "--json", "record", "--seconds", "4", "--out", "r.csv", "--profile", "p.csv"],
+    );
+    assert!(rec["samples"].as_u64().expect("samples") > 7000, "{rec}");
+}

@@ -393,6 +393,29 @@ impl Link {
         }
     }
 
+    /// Read the board's clock again: a claim repeated with this link's nonce is answered
+    /// with the session it holds and the clock. Over a long run without acks (a profile
+    /// streamed for an hour) the host's estimate of the board's clock would drift with the
+    /// two crystals; read again every second, it stays within a few ms.
+    pub fn resync(&mut self) -> Result<(), LinkError> {
+        let nonce = self.nonce;
+        self.send(Command::Claim { nonce })?;
+        let accept = move |r: &Response| match r {
+            Response::Session { nonce: n, .. } => *n == nonce,
+            Response::Nack { code: 0x06, .. } => true,
+            _ => false,
+        };
+        match self.reply("the clock read", REPLY, &accept)? {
+            Some(Response::Session { .. }) => Ok(()),
+            Some(Response::Nack { why, .. }) => Err(self.refused("the clock read", why)),
+            _ => Err(LinkError::Timeout {
+                port: self.port.clone(),
+                what: "the clock read",
+                ms: REPLY.as_millis() as u64,
+            }),
+        }
+    }
+
     /// The guard of the next command, its deadline `lead` ahead of the board's clock.
     fn next_guard(&mut self, lead: Duration) -> Result<Guard, LinkError> {
         self.claim()?;

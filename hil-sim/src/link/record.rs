@@ -42,6 +42,8 @@ const PROFILE_PERIOD: f64 = 1e-3;
 /// While this host drives the board, a heartbeat at least this often (board time), s (the
 /// board releases the drive after 100 ms without a command of its session).
 const KEEPALIVE_PERIOD: f64 = 20e-3;
+/// While this host drives, the board's clock is read again this often (board time), s.
+const RESYNC_PERIOD: f64 = 1.0;
 /// Shortest and longest recording, s: a few hundred samples at the least, so that `fit`
 /// has something to fit; a day at the most.
 pub const SECONDS: (f64, f64) = (0.1, 86_400.0);
@@ -219,6 +221,7 @@ fn stream_rows(
 ) -> Option<Cut> {
     let (mut t0, mut last_us, mut wraps) = (None::<f64>, 0u32, 0u64);
     let (mut next_send, mut done_ms, mut was_running) = (0.0f64, 0u64, false);
+    let mut next_sync = RESYNC_PERIOD;
     let refused0 = link.stats.refused;
     // Board time must move: a stopped clock (or a board far slower than real time) ends the
     // recording after twice its length plus the silence allowance of wall time.
@@ -257,6 +260,12 @@ fn stream_rows(
             if link.stats.refused > refused0 {
                 let why = link.stats.last_refusal.map_or("no reason given", super::client::why);
                 return Some(Cut::Refused(why.to_owned()));
+            }
+            if plan.driving && t - start >= next_sync {
+                next_sync += RESYNC_PERIOD;
+                if let Err(e) = link.resync() {
+                    return Some(Cut::Link(e));
+                }
             }
             if t - start >= next_send {
                 if let Err(e) = keep_driving(link, plan, t - start, &mut next_send) {
