@@ -153,6 +153,15 @@ pub fn why(n: Nack) -> &'static str {
     }
 }
 
+/// The replies that answer a claim with `nonce`: its session, or the refusal.
+fn answers_claim(nonce: u16) -> impl Fn(&Response) -> bool {
+    move |r: &Response| match r {
+        Response::Session { nonce: n, .. } => *n == nonce,
+        Response::Nack { code: 0x06, .. } => true,
+        _ => false,
+    }
+}
+
 /// A nonce for a claim: different for every link the process opens.
 fn nonce() -> u16 {
     use std::hash::{BuildHasher, Hasher};
@@ -361,11 +370,7 @@ impl Link {
             return Ok(());
         }
         let nonce = self.nonce;
-        let accept = move |r: &Response| match r {
-            Response::Session { nonce: n, .. } => *n == nonce,
-            Response::Nack { code: 0x06, .. } => true,
-            _ => false,
-        };
+        let accept = answers_claim(nonce);
         let give_up = Instant::now() + Duration::from_millis(IDLE_MS) + REPLY;
         let mut answered = false;
         loop {
@@ -400,11 +405,7 @@ impl Link {
     pub fn resync(&mut self) -> Result<(), LinkError> {
         let nonce = self.nonce;
         self.send(Command::Claim { nonce })?;
-        let accept = move |r: &Response| match r {
-            Response::Session { nonce: n, .. } => *n == nonce,
-            Response::Nack { code: 0x06, .. } => true,
-            _ => false,
-        };
+        let accept = answers_claim(nonce);
         match self.reply("the clock read", REPLY, &accept)? {
             Some(Response::Session { .. }) => Ok(()),
             Some(Response::Nack { why, .. }) => Err(self.refused("the clock read", why)),
@@ -480,7 +481,7 @@ impl Link {
         r
     }
 
-    /// A guarded command answered by an ack.
+    /// An unguarded command answered by an ack (the telemetry request).
     pub fn ack(&mut self, cmd: Command, what: &'static str) -> Result<(), LinkError> {
         match self.request(cmd, what, REPLY)? {
             Response::Ack { .. } => Ok(()),
