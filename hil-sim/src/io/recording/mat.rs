@@ -290,6 +290,9 @@ fn structure(c: &mut Cursor<'_>, dims: &[u64], base: usize, e: Endian, left: &mu
     if cells.saturating_mul(8) > (c.buf.len() - c.pos.min(c.buf.len())) as u64 {
         return Err(Fault::Format(format!("struct at byte {base}: {cells} fields do not fit in its data")));
     }
+    // A struct without fields (MATLAB's `struct()`) holds no data whatever its size: its
+    // elements are all empty, and none is kept (the count is the file's word, not a length).
+    let count = if fields.is_empty() { 0 } else { count };
     let mut elements = Vec::with_capacity(count as usize);
     for _ in 0..count {
         let mut row = Vec::with_capacity(fields.len());

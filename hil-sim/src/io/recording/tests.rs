@@ -158,3 +158,35 @@ fn to_big_endian(le: &[u8]) -> Vec<u8> {
     elements(&le[128..], &mut out);
     out
 }
+
+/// A level-5 element: tag (type, size) then the data padded to 8 bytes.
+fn mat_element(t: u32, data: &[u8]) -> Vec<u8> {
+    let mut out = t.to_le_bytes().to_vec();
+    out.extend((data.len() as u32).to_le_bytes());
+    out.extend_from_slice(data);
+    out.resize(8 + data.len().div_ceil(8) * 8, 0);
+    out
+}
+
+/// A struct array with no fields but a huge element count: nothing to read per element, so
+/// the count must not become an allocation or a loop (it did: a capacity overflow panic).
+#[test]
+fn a_struct_with_no_fields_and_a_huge_count_is_read_without_allocating() {
+    let mut flags = 2u32.to_le_bytes().to_vec(); // class 2: struct
+    flags.extend([0; 4]);
+    let mut dims = i32::MAX.to_le_bytes().to_vec();
+    dims.extend(i32::MAX.to_le_bytes());
+    let mut payload = mat_element(6, &flags);
+    payload.extend(mat_element(5, &dims));
+    payload.extend(mat_element(1, b"Y"));
+    payload.extend(mat_element(5, &8i32.to_le_bytes()));
+    payload.extend(mat_element(1, b""));
+    let mut bytes = format!("{:<116}", "MATLAB 5.0 MAT-file").into_bytes();
+    bytes.extend([0u8; 8]);
+    bytes.extend(0x0100u16.to_le_bytes());
+    bytes.extend(b"IM");
+    bytes.extend(mat_element(14, &payload));
+    // The file holds no channel: refused in one line naming it, after reading the struct.
+    let e = Recording::parse(Path::new("s.mat"), &bytes).unwrap_err().to_string();
+    assert!(e.contains("s.mat") && !e.contains("capacity"), "{e}");
+}
