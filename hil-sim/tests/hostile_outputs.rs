@@ -36,6 +36,9 @@ fn hostile_file_name_is_text_in_the_report() {
         let md = std::fs::read_to_string(out.join("report.md")).unwrap();
         let folder = dir.to_str().unwrap();
         assert!(!html.contains(folder) && !md.contains(folder), "{cmd}: absolute path in the report");
+        // Issue 61: the Markdown is read by viewers that render raw HTML.
+        assert!(!md.contains("<img"), "{cmd}: raw HTML in report.md: {md}");
+        assert!(md.contains("&lt;img src=x"), "{cmd}: the name is gone from report.md");
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

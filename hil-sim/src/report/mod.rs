@@ -109,9 +109,12 @@ impl Report {
         self
     }
 
-    /// The Markdown text.
-    pub fn markdown(&self) -> &str {
-        &self.md
+    /// The Markdown text as written to `report.md`: raw HTML in it (a file name such as
+    /// `<img onerror=…>.csv` inside a title, cell or caption) is escaped so that a Markdown
+    /// viewer shows it as text, and a link to anything but the web or a relative path is
+    /// shown as its text, as the HTML page does ([`Report::html`]).
+    pub fn markdown(&self) -> String {
+        inert(&self.md)
     }
 
     /// A standalone HTML page for the report in `dir`: SVG images that exist under `dir`
@@ -155,7 +158,7 @@ impl Report {
     pub fn write(&self, dir: impl AsRef<Path>) -> Result<PathBuf, ReportError> {
         let dir = dir.as_ref();
         output::create_dir(dir)?;
-        output::write(&dir.join("report.md"), &self.md)?;
+        output::write(&dir.join("report.md"), self.markdown())?;
         let index = dir.join("index.html");
         output::write(&index, self.html(dir))?;
         Ok(index)
@@ -240,6 +243,41 @@ pub fn relabel(msg: &str, path: &Path) -> String {
 }
 
 /// A link the page may carry: to the web or relative (no `javascript:`, `data:`, …).
+/// `md` with every raw HTML span or block escaped (`<` as `&lt;`, which Markdown shows as
+/// the character) and the brackets of every unsafe link escaped (the link becomes its text):
+/// the places are those the CommonMark parser itself finds, so intended markup (emphasis,
+/// code, tables, images) is untouched.
+fn inert(md: &str) -> String {
+    let mut opts = Options::empty();
+    opts.insert(Options::ENABLE_TABLES);
+    // (byte offset, what replaces the one byte there)
+    let mut edits: Vec<(usize, &str)> = Vec::new();
+    for (ev, range) in Parser::new_ext(md, opts).into_offset_iter() {
+        match ev {
+            Event::Html(_) | Event::InlineHtml(_) => {
+                edits.extend(md[range.clone()].match_indices('<').map(|(i, _)| (range.start + i, "&lt;")));
+            }
+            Event::Start(Tag::Link { ref dest_url, .. }) if !safe_link(dest_url) => {
+                if md[range.clone()].starts_with('[') {
+                    edits.push((range.start, "\\["));
+                }
+            }
+            _ => {}
+        }
+    }
+    edits.sort_unstable_by_key(|e| e.0);
+    edits.dedup_by_key(|e| e.0);
+    let mut out = String::with_capacity(md.len() + 4 * edits.len());
+    let mut at = 0;
+    for (i, with) in edits {
+        out.push_str(&md[at..i]);
+        out.push_str(with);
+        at = i + 1;
+    }
+    out.push_str(&md[at..]);
+    out
+}
+
 fn safe_link(dest: &str) -> bool {
     let d = dest.trim_start().to_ascii_lowercase();
     d.starts_with("https://") || d.starts_with("http://") || !d.contains(':')
@@ -279,10 +317,36 @@ mod tests {
     #[test]
     fn markdown_has_every_block() {
         let md = sample().markdown().to_owned();
-        assert!(md.starts_with("# Fit <report>\n\n## Held-out error\n\n"));
+        assert!(md.starts_with("# Fit &lt;report>\n\n## Held-out error\n\n"), "{md}");
         assert!(md.contains("| model | RMSE (N) | note |\n| --- | --- | --- |\n| spencer | 196.5 | a\\|b |\n"));
         assert!(md.contains("| algebraic | 250.1 |  |\n"));
         assert!(md.contains("![Force against displacement](loop.svg)\n\n*Force against displacement*"));
+    }
+
+    /// A recording's name is text in `report.md` as in `index.html`: no raw HTML and no
+    /// unsafe link survives for a Markdown viewer to render.
+    #[test]
+    fn markdown_carries_no_raw_html_or_unsafe_link() {
+        let name = "<img src=x onerror=alert(1)>.csv";
+        let mut r = Report::new(format!("Fit of {name}"));
+        r.paragraph(&format!("Fitted on {name}; see [the docs](javascript:alert(2)) and *this*."))
+            .paragraph("<div onclick=\"x()\">block</div>")
+            .table(&["run"], &[vec![name.to_owned()]])
+            .image("loop.svg", name);
+        let md = r.markdown();
+        let mut opts = Options::empty();
+        opts.insert(Options::ENABLE_TABLES);
+        for ev in Parser::new_ext(&md, opts) {
+            assert!(!matches!(ev, Event::Html(_) | Event::InlineHtml(_)), "{ev:?} in {md}");
+            if let Event::Start(Tag::Link { dest_url, .. }) = &ev {
+                assert!(safe_link(dest_url), "{dest_url} in {md}");
+            }
+        }
+        // What is shown is still the name, and the intended markup is kept.
+        let mut html = String::new();
+        html::push_html(&mut html, Parser::new_ext(&md, opts));
+        assert!(html.contains("Fit of &lt;img src=x onerror=alert(1)&gt;.csv"), "{html}");
+        assert!(html.contains("<em>this</em>") && html.contains("<table>"), "{html}");
     }
 
     #[test]
