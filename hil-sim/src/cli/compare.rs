@@ -21,6 +21,9 @@ pub struct CompareArgs {
     /// `validate` runs the validation ones (each with its own channels and constants).
     #[arg(long, value_name = "TOML", conflicts_with_all = ["fit", "validate"])]
     pub dataset: Option<PathBuf>,
+    /// Let the manifest's runs name files outside its folder (absolute paths, `..`).
+    #[arg(long, requires = "dataset")]
+    pub allow_outside: bool,
     /// Validation recordings (seed 000: multi-sine and swept sine), replayed whole with the
     /// averaged parameters.
     #[arg(long = "validate", num_args = 1..)]
@@ -51,7 +54,13 @@ pub fn run(a: CompareArgs) -> anyhow::Result<()> {
     let models = super::fit::model_list(&a.model)?;
     let ch = a.ch.channels();
     let runs: Vec<RunSpec> = match &a.dataset {
-        Some(m) => from_manifest(&super::file_arg(m)?, &ch)?,
+        Some(m) => {
+            let paths = match a.allow_outside {
+                true => hil_sim::io::manifest::RunPaths::Anywhere,
+                false => hil_sim::io::manifest::RunPaths::InsideFolder,
+            };
+            from_manifest(&super::file_arg(m)?, &ch, paths)?
+        }
         None => {
             let run = |p: &PathBuf, role| RunSpec { path: p.clone(), channels: ch.clone(), role };
             a.fit.iter().map(|p| run(p, Role::Train)).chain(a.validate.iter().map(|p| run(p, Role::Validate))).collect()

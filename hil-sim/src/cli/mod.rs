@@ -121,14 +121,19 @@ pub struct RecordingArgs {
     /// its `file`, `set` and `role` = train|validate; see README).
     #[arg(long, value_name = "TOML", conflicts_with = "recs")]
     pub dataset: Option<PathBuf>,
+    /// Let the manifest's runs name files outside its folder (absolute paths, `..`).
+    #[arg(long, requires = "dataset")]
+    pub allow_outside: bool,
 }
 
 impl RecordingArgs {
     /// The runs named, each with its channels (the manifest's over `ch`'s).
     pub fn runs(&self, ch: &Channels) -> anyhow::Result<Vec<hil_sim::ident::runs::RunSpec>> {
         use hil_sim::ident::runs::{from_manifest, RunSpec};
+        use hil_sim::io::manifest::RunPaths;
         if let Some(m) = &self.dataset {
-            let runs = from_manifest(&file_arg(m)?, ch)?;
+            let paths = if self.allow_outside { RunPaths::Anywhere } else { RunPaths::InsideFolder };
+            let runs = from_manifest(&file_arg(m)?, ch, paths)?;
             for r in &runs {
                 file_arg(&r.path).map_err(|e| anyhow::anyhow!("{}: run {e}", m.display()))?;
             }

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 use crate::ident::dataset::{prepare, Dataset, DatasetError, Prepared, RunSpan};
-use crate::io::manifest::{Manifest, ManifestError, Role};
+use crate::io::manifest::{Manifest, ManifestError, Role, RunPaths};
 use crate::io::recording::Channels;
 use crate::quality::Quality;
 
@@ -33,11 +33,17 @@ pub enum RunsError {
     Step { path: PathBuf, dt: f64, first_path: PathBuf, first: f64 },
     #[error("{}: has a command channel but {} has none; the runs of a dataset share their channels", with.display(), without.display())]
     Command { with: PathBuf, without: PathBuf },
+    #[error(
+        "{}: a validate run that {how} the train run {}: its score would not be a held-out one \
+         (validate on a recording the fit never saw)", validate.display(), train.display()
+    )]
+    NotHeldOut { validate: PathBuf, train: PathBuf, how: String },
 }
 
-/// The runs of a manifest, with `ch` (the command line's channels) under its `[channels]`.
-pub fn from_manifest(path: &Path, ch: &Channels) -> Result<Vec<RunSpec>, RunsError> {
-    let m = Manifest::read(path)?;
+/// The runs of a manifest, with `ch` (the command line's channels) under its `[channels]`;
+/// `paths` says whether its files may lie outside its folder.
+pub fn from_manifest(path: &Path, ch: &Channels, paths: RunPaths) -> Result<Vec<RunSpec>, RunsError> {
+    let m = Manifest::read(path, paths)?;
     let d = &m.channels;
     let base = Channels {
         time: d.time.clone().unwrap_or_else(|| ch.time.clone()),
@@ -102,6 +108,9 @@ pub fn join_prepared(runs: Vec<(Prepared, Role)>) -> Result<PreparedRuns, RunsEr
         }
     }
     let any_validate = roles.contains(&Role::Validate);
+    if any_validate {
+        held_out(&runs, &roles)?;
+    }
     let joined = join(&runs, &roles, any_validate);
     let mut quality =
         Quality { warnings: Vec::new(), samples: 0, excluded_samples: 0, notes: Vec::new(), unusable: Vec::new() };
@@ -119,6 +128,87 @@ pub fn join_prepared(runs: Vec<(Prepared, Role)>) -> Result<PreparedRuns, RunsEr
     }
     let joined = Prepared { recording: first.recording.clone(), quality, data: joined };
     Ok(PreparedRuns { joined, runs })
+}
+
+/// Consecutive samples two runs must share, identical in input and output, to overlap: far
+/// more than chance makes equal in measured (noisy, many-valued) signals.
+const OVERLAP: usize = 64;
+
+/// Refuse a `validate` run that is not held out from the `train` runs: the same file (also
+/// under another name or through a link), the same samples (a copy), or a stretch of
+/// [`OVERLAP`] samples or more in common with one (a cut of the same recording).
+fn held_out(runs: &[Prepared], roles: &[Role]) -> Result<(), RunsError> {
+    let train: Vec<&Prepared> = runs.iter().zip(roles).filter(|(_, r)| **r == Role::Train).map(|(p, _)| p).collect();
+    // Every aligned window of OVERLAP/2 samples of every train run: a stretch of OVERLAP
+    // shared samples holds at least one of them whole.
+    let w = OVERLAP / 2;
+    let mut windows: std::collections::HashMap<u64, Vec<(usize, usize)>> = std::collections::HashMap::new();
+    for (k, t) in train.iter().enumerate() {
+        let h = sample_hashes(&t.data);
+        for start in (0..h.len().saturating_sub(w - 1)).step_by(w) {
+            windows.entry(window_hash(&h[start..start + w])).or_default().push((k, start));
+        }
+    }
+    for v in runs.iter().zip(roles).filter(|(_, r)| **r == Role::Validate).map(|(p, _)| p) {
+        let refuse = |t: &Prepared, how: String| RunsError::NotHeldOut {
+            validate: v.recording.path.clone(),
+            train: t.recording.path.clone(),
+            how,
+        };
+        for t in &train {
+            if crate::io::output::same_file(&v.recording.path, &t.recording.path) {
+                return Err(refuse(t, "is the same file as".into()));
+            }
+            let (a, b) = (&v.data, &t.data);
+            if a.input == b.input && a.output == b.output && a.command == b.command {
+                return Err(refuse(t, "holds the same samples as".into()));
+            }
+        }
+        let h = sample_hashes(&v.data);
+        for start in 0..h.len().saturating_sub(w - 1) {
+            let Some(hits) = windows.get(&window_hash(&h[start..start + w])) else { continue };
+            for &(k, at) in hits {
+                let t = train[k];
+                let same = |i: usize, j: usize| {
+                    v.data.input.get(i) == t.data.input.get(j) && v.data.output.get(i) == t.data.output.get(j)
+                };
+                if (0..w).all(|i| same(start + i, at + i)) && informative(&v.data, start, w) {
+                    let time = v.data.time.get(start).copied().unwrap_or(0.0);
+                    return Err(refuse(t, format!("shares samples from {time:.4} s on with")));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One hash per sample of the input and output values (their bits).
+fn sample_hashes(d: &Dataset) -> Vec<u64> {
+    d.input.iter().zip(&d.output).map(|(x, y)| mix(x.to_bits() ^ mix(y.to_bits()))).collect()
+}
+
+fn window_hash(h: &[u64]) -> u64 {
+    h.iter().fold(0x9E37_79B9_7F4A_7C15, |a, &x| mix(a ^ x))
+}
+
+/// SplitMix64's finaliser: a cheap, well-spread 64-bit mix.
+fn mix(mut z: u64) -> u64 {
+    z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// Whether samples `start..start + w` vary enough (in input and output) that two recordings
+/// share them only by being one: a stretch at rest (the same few levels in every run) is not.
+fn informative(d: &Dataset, start: usize, w: usize) -> bool {
+    let distinct = |v: &[f64]| {
+        let mut bits: Vec<u64> = v.get(start..start + w).unwrap_or(&[]).iter().map(|x| x.to_bits()).collect();
+        bits.sort_unstable();
+        bits.dedup();
+        bits.len()
+    };
+    distinct(&d.input) >= w / 4 && distinct(&d.output) >= w / 4
 }
 
 /// The runs' data end to end (time made to continue, one step after the previous run).

@@ -35,7 +35,7 @@ pub fn note_input(path: &Path) {
 
 /// Whether two paths name the same existing file (device and inode where the OS tells,
 /// else the canonical paths).
-fn same_file(a: &Path, b: &Path) -> bool {
+pub fn same_file(a: &Path, b: &Path) -> bool {
     let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) else {
         return false;
     };

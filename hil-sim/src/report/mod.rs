@@ -257,10 +257,10 @@ fn inert(md: &str) -> String {
             Event::Html(_) | Event::InlineHtml(_) => {
                 edits.extend(md[range.clone()].match_indices('<').map(|(i, _)| (range.start + i, "&lt;")));
             }
-            Event::Start(Tag::Link { ref dest_url, .. }) if !safe_link(dest_url) => {
-                if md[range.clone()].starts_with('[') {
-                    edits.push((range.start, "\\["));
-                }
+            Event::Start(Tag::Link { ref dest_url, .. })
+                if !safe_link(dest_url) && md[range.clone()].starts_with('[') =>
+            {
+                edits.push((range.start, "\\["));
             }
             _ => {}
         }

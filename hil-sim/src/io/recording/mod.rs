@@ -29,6 +29,11 @@ pub enum RecordingError {
     Malformed { path: PathBuf, line: u64, reason: String },
     #[error("{path}:{line}: column `{column}`: `{text}` is not a number{hint}")]
     NotANumber { path: PathBuf, line: u64, column: String, text: String, hint: String },
+    #[error(
+        "{path}:{line}: field {field} is not a number and no row before it was: not a recording{hint}, or one \
+         with more than one header row (its content is not shown)"
+    )]
+    NotARecording { path: PathBuf, line: u64, field: usize, hint: String },
     #[error("{path}:{line}: column `{column}`: value is {text} (NaN/Inf are not accepted)")]
     NonFinite { path: PathBuf, line: u64, column: String, text: String },
     #[error("{path}:{line}: column `{column}` has no value")]

@@ -34,6 +34,13 @@ fn errors_name_line_and_reason() {
     assert!(msg("t,x\n").contains("empty"));
     let m = msg("t,x\n0,1\n0.1,abc\n0.2,3\n");
     assert!(m.contains("rec.csv:3") && m.contains("`abc` is not a number"), "{m}");
+    // A file whose first data row is not numbers is not known to be a recording: its
+    // content is never quoted (a manifest could name /etc/shadow).
+    let m = msg("root:*:19000:0:99999:7:::\ndaemon:*:19000:0:99999:7:::\nbin:*:1:2\n");
+    assert!(m.contains("rec.csv:2: field 1 is not a number") && m.contains("content is not shown"), "{m}");
+    assert!(!m.contains("root") && !m.contains("daemon") && !m.contains("19000"), "{m}");
+    let m = msg("a,a\nsecret,1\n2,3\n");
+    assert!(!m.contains("secret") && !m.contains("`a`"), "{m}");
     let m = msg("t,x\n0,1\n0.1,NaN\n0.2,3\n");
     assert!(m.contains("rec.csv:3") && m.contains("NaN"), "{m}");
     let m = msg("t,x\n0,1\n0.1,\n0.2,3\n");

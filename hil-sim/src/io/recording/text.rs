@@ -60,17 +60,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Recording, RecordingErr
             reason: "the header row has no column names".into(),
         });
     }
-    let mut seen = std::collections::HashSet::with_capacity(names.len());
     let header_line = first.position().map_or(1, |pos| pos.line());
-    for n in &names {
-        if !n.is_empty() && !seen.insert(n.as_str()) {
-            return Err(RecordingError::Malformed {
-                path: p(),
-                line: header_line,
-                reason: format!("column `{}` appears twice in the header", shown(n)),
-            });
-        }
-    }
     let width = names.len();
     let mut raw: Vec<Vec<Option<f64>>> = vec![Vec::new(); width];
     let mut lines = Vec::new();
@@ -96,12 +86,17 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Recording, RecordingErr
                 col.push(None);
                 continue;
             }
-            let v = text.parse::<f64>().map_err(|_| RecordingError::NotANumber {
-                path: p(),
-                line,
-                column: name(),
-                text: shown(text),
-                hint: not_a_number_hint(text, dialect, &hint),
+            // Until a row has been read as numbers the file is not known to be a recording
+            // (a manifest or a flag may name any file): nothing of it is quoted.
+            let v = text.parse::<f64>().map_err(|_| match lines.is_empty() {
+                true => RecordingError::NotARecording { path: p(), line, field: i + 1, hint: hint.clone() },
+                false => RecordingError::NotANumber {
+                    path: p(),
+                    line,
+                    column: name(),
+                    text: shown(text),
+                    hint: not_a_number_hint(text, dialect, &hint),
+                },
             })?;
             if !v.is_finite() {
                 return Err(RecordingError::NonFinite { path: p(), line, column: name(), text: shown(text) });
@@ -113,6 +108,17 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Recording, RecordingErr
     let rows = lines.len();
     if rows == 0 {
         return Err(RecordingError::HeaderOnly { path: p() });
+    }
+    // The header is judged once rows of numbers show the file is a recording.
+    let mut seen = std::collections::HashSet::with_capacity(names.len());
+    for n in &names {
+        if !n.is_empty() && !seen.insert(n.as_str()) {
+            return Err(RecordingError::Malformed {
+                path: p(),
+                line: header_line,
+                reason: format!("column `{}` appears twice in the header", shown(n)),
+            });
+        }
     }
     let (columns, constants) = columns(path, names, raw, &lines)?;
     if rows < 3 {

@@ -1,0 +1,109 @@
+//! What is read is trusted only as far as it should be: a held-out run that is not held out
+//! is refused with both names, and a manifest reads only the files of its own folder and
+//! quotes nothing of a file that is not a recording.
+
+mod common;
+use std::path::Path;
+
+use common::{hil_sim, scratch};
+
+/// A simulated recording (2 s at 500 Hz, noise excitation) with random seed `seed`.
+fn simulate(path: &Path, seed: u64) {
+    let seed = seed.to_string();
+    let (code, _, err) = hil_sim(&[
+        "simulate",
+        "--effect",
+        "field_lag",
+        "--base",
+        "algebraic",
+        "--excitation",
+        "noise",
+        "--seed",
+        &seed,
+        "--duration",
+        "2",
+        "--fs",
+        "500",
+        "--out",
+        path.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+}
+
+/// A manifest in `dir` with a train and a validate run.
+fn manifest(dir: &Path, train: &str, validate: &str) -> String {
+    let m = dir.join("runs.toml");
+    let text = format!("[[run]]\nfile = \"{train}\"\n\n[[run]]\nfile = \"{validate}\"\nrole = \"validate\"\n");
+    std::fs::write(&m, text).unwrap();
+    m.display().to_string()
+}
+
+fn one_error(err: &str) -> bool {
+    err.lines().filter(|l| l.starts_with("error")).count() == 1
+}
+
+/// Issue 61, behaviour 2: the same file, a copy of it, or a cut of it as the validate run
+/// gave a held-out score equal to the training one, exit 0.
+#[test]
+fn a_validate_run_that_the_fit_saw_is_refused_with_both_names() {
+    let dir = scratch("heldout");
+    simulate(&dir.join("a.csv"), 1);
+    simulate(&dir.join("other.csv"), 2);
+    std::fs::copy(dir.join("a.csv"), dir.join("copy.csv")).unwrap();
+    // A cut: rows 300-700 of a.csv (header kept), time as recorded.
+    let text = std::fs::read_to_string(dir.join("a.csv")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let cut = std::iter::once(lines[0]).chain(lines[300..700].iter().copied()).collect::<Vec<_>>().join("\n");
+    std::fs::write(dir.join("cut.csv"), cut + "\n").unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(dir.join("a.csv"), dir.join("link.csv")).unwrap();
+    let fit = |m: &str| hil_sim(&["fit", "--dataset", m, "--model", "algebraic", "--delay", "off"]);
+    for (validate, how) in [
+        ("a.csv", "is the same file as"),
+        ("link.csv", "is the same file as"),
+        ("copy.csv", "holds the same samples as"),
+        ("cut.csv", "shares samples from"),
+    ] {
+        let (code, _, err) = fit(&manifest(&dir, "a.csv", validate));
+        assert_ne!(code, 0, "{validate}: accepted");
+        assert!(err.contains(validate) && err.contains("a.csv") && err.contains(how), "{validate}: {err}");
+        assert!(one_error(&err), "{err}");
+    }
+    // Two different recordings: a held-out score.
+    let (code, out, err) = fit(&manifest(&dir, "a.csv", "other.csv"));
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("scored on the validate runs"), "{out}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Issue 61, behaviour 3: a manifest read any file of the machine and printed its content
+/// in the error.
+#[test]
+fn a_manifest_reads_only_its_folder_and_quotes_no_other_file() {
+    let dir = scratch("manifest-paths");
+    simulate(&dir.join("a.csv"), 1);
+    let secret = dir.join("outside-secret.txt");
+    std::fs::write(&secret, "root:TOPSECRET:19000:0:99999:7:::\ndaemon:*:19000:0:99999:7:::\n").unwrap();
+    let inner = dir.join("data");
+    std::fs::create_dir_all(&inner).unwrap();
+    std::fs::copy(dir.join("a.csv"), inner.join("a.csv")).unwrap();
+    #[cfg(unix)]
+    std::os::unix::fs::symlink(&secret, inner.join("link.csv")).unwrap();
+    let mut cases = vec![secret.display().to_string(), "../outside-secret.txt".to_owned()];
+    if cfg!(unix) {
+        cases.push("link.csv".to_owned());
+    }
+    for file in &cases {
+        let m = manifest(&inner, "a.csv", file);
+        let (code, _, err) = hil_sim(&["fit", "--dataset", &m, "--model", "algebraic"]);
+        assert_ne!(code, 0, "{file}: accepted");
+        assert!(err.contains("outside the manifest's folder") && err.contains("--allow-outside"), "{file}: {err}");
+        assert!(!err.contains("TOPSECRET") && !err.contains("daemon"), "{file}: content quoted: {err}");
+        // Allowed, the file is read, and refused without a word of it.
+        let (code, _, err) = hil_sim(&["fit", "--dataset", &m, "--allow-outside", "--model", "algebraic"]);
+        assert_ne!(code, 0, "{file}: accepted");
+        assert!(err.contains("not a recording") && err.contains("content is not shown"), "{file}: {err}");
+        assert!(!err.contains("TOPSECRET") && !err.contains("root") && !err.contains("daemon"), "{file}: {err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
