@@ -107,3 +107,54 @@ fn a_manifest_reads_only_its_folder_and_quotes_no_other_file() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 61, behaviour 4: a parameter file named every recording of the dataset in its
+/// `source` (2 MB for 10,000 runs, over what `replay` and `export` read). Its size is now
+/// that of the parameters, whatever the number of runs, and the per-run metrics are beside
+/// it.
+#[test]
+fn what_fit_saves_replay_reads_whatever_the_number_of_runs() {
+    let dir = scratch("many-runs");
+    let mut manifest = String::new();
+    for k in 0..300 {
+        let name = format!("run-with-a-long-descriptive-name-{k:04}.csv");
+        let mut text = String::from("t,b,torque\n");
+        for i in 0..120 {
+            let t = i as f64 * 0.002;
+            let b = 0.4 + 0.35 * (t * (20.0 + k as f64 * 0.1)).sin() + 0.001 * ((i * 7919 + k) % 13) as f64;
+            text += &format!("{t:.4},{b:.6},{:.5}\n", 10.0 * (4.0 * b).tanh() + 0.05 * ((i * 31 + k) % 7) as f64);
+        }
+        std::fs::write(dir.join(&name), text).unwrap();
+        manifest += &format!("[[run]]\nfile = \"{name}\"\n");
+    }
+    let m = dir.join("runs.toml");
+    std::fs::write(&m, manifest).unwrap();
+    let save = dir.join("saved");
+    let (code, _, err) = hil_sim(&[
+        "fit",
+        "--dataset",
+        m.to_str().unwrap(),
+        "--model",
+        "algebraic",
+        "--delay",
+        "off",
+        "--keep-flagged",
+        "--save",
+        save.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let params = save.join("algebraic.json");
+    let bytes = std::fs::metadata(&params).unwrap().len();
+    assert!(bytes < 4096, "a parameter file of {bytes} bytes for 300 runs");
+    let text = std::fs::read_to_string(&params).unwrap();
+    assert!(text.contains("300 recordings") && text.contains("0000.csv") && text.contains("0299.csv"), "{text}");
+    let results: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(save.join("fit-results.json")).unwrap()).unwrap();
+    assert_eq!(results["results"][0]["runs"].as_array().map(Vec::len), Some(300), "per-run metrics");
+    let (code, _, err) = hil_sim(&["replay", "--dataset", m.to_str().unwrap(), "--params", params.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let (code, _, err) =
+        hil_sim(&["export", params.to_str().unwrap(), "--out", dir.join("page.bin").to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -25,7 +25,7 @@ pub struct FitJob {
     pub keep_flagged: bool,
     pub models: Vec<String>,
     pub options: FitOptions,
-    /// Write each fitted set as `<dir>/<model>.json`.
+    /// Write each fitted set as `<dir>/<model>.json`, and the metrics as [`RESULTS_FILE`].
     pub save: Option<PathBuf>,
 }
 
@@ -38,7 +38,7 @@ pub struct FitRun {
     pub runs: Vec<Prepared>,
     /// One per model, in the job's order.
     pub results: Vec<FitResult>,
-    /// Parameter files written.
+    /// Files written: the parameter files, then [`RESULTS_FILE`].
     pub saved: Vec<PathBuf>,
     /// Wall time of the fits, seconds.
     pub total_seconds: f64,
@@ -161,19 +161,47 @@ pub fn save(
     let err = |path: &Path, reason: String| FitJobError::Save { path: path.to_owned(), reason };
     crate::io::output::create_dir(dir).map_err(|e| err(dir, e.to_string()))?;
     let mut written = Vec::with_capacity(results.len());
+    let source = format!("hil-sim fit {}", source_label(recordings));
     for r in results {
         let file = dir.join(format!("{}.json", r.model));
         let flat: Vec<f32> = r.flat.iter().map(|v| *v as f32).collect();
-        let names: Vec<String> = recordings.iter().map(|p| p.display().to_string()).collect();
-        let mut pf = ParamsFile::from_flat(&r.model, Some(format!("hil-sim fit {}", names.join(" "))), &flat)
+        let mut pf = ParamsFile::from_flat(&r.model, Some(source.clone()), &flat)
             .ok_or_else(|| err(&file, "cannot build the parameter file".into()))?;
         pf.channels = Some(channels.clone());
         pf.rate = Some(r.rate.clone());
         pf.delay_s = (r.delay_s != 0.0).then_some(r.delay_s);
         pf.command_delay_s = (r.command_delay_s != 0.0).then_some(r.command_delay_s);
         let text = serde_json::to_string_pretty(&pf).map_err(|e| err(&file, e.to_string()))? + "\n";
+        // What `replay` and `export` read, `fit` writes: never a file they would refuse.
+        if text.len() as u64 > crate::io::params_file::MAX_BYTES {
+            return Err(err(&file, format!("{} bytes, over the parameter file limit", text.len())));
+        }
         crate::io::output::write(&file, text).map_err(|e| err(&file, e.to_string()))?;
         written.push(file);
     }
+    // The scores, per model and per run, beside the sets: as large as the dataset is, so
+    // never inside a parameter file.
+    let file = dir.join(RESULTS_FILE);
+    let text = serde_json::to_string_pretty(&serde_json::json!({ "source": source, "results": results }))
+        .map_err(|e| err(&file, e.to_string()))?
+        + "\n";
+    crate::io::output::write(&file, text).map_err(|e| err(&file, e.to_string()))?;
+    written.push(file);
     Ok(written)
+}
+
+/// The file `fit --save DIR` writes beside the parameter files: every model's metrics,
+/// pooled and per run.
+pub const RESULTS_FILE: &str = "fit-results.json";
+
+/// The recordings a set was fitted on, as its `source` names them: all of them when they
+/// are few, else how many with the first and the last (a dataset of thousands of runs would
+/// make a parameter file of megabytes).
+fn source_label(recordings: &[&Path]) -> String {
+    const LISTED: usize = 4;
+    let names: Vec<String> = recordings.iter().map(|p| p.display().to_string()).collect();
+    match names.as_slice() {
+        [first, .., last] if names.len() > LISTED => format!("{} recordings: {first} … {last}", names.len()),
+        _ => names.join(" "),
+    }
 }
