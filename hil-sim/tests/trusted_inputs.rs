@@ -158,3 +158,57 @@ fn what_fit_saves_replay_reads_whatever_the_number_of_runs() {
     assert_eq!(code, 0, "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 61, behaviour 1: 100 s added to the time column from row 1502 on made the fit step
+/// at 29.7 Hz instead of 3 kHz (the rate taken over the gap), exit 0. The rate now comes from
+/// the intervals that are not gaps, the gap splits the recording into runs, and it is
+/// reported as a gap (not as a 100 s standstill).
+#[test]
+fn a_gap_in_the_time_column_splits_the_recording_and_leaves_the_rate_alone() {
+    let dir = scratch("gap");
+    let plain = dir.join("plain.csv");
+    let (code, _, err) = hil_sim(&[
+        "simulate",
+        "--effect",
+        "field_lag",
+        "--base",
+        "algebraic",
+        "--excitation",
+        "noise",
+        "--duration",
+        "2",
+        "--fs",
+        "3000",
+        "--out",
+        plain.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let text = std::fs::read_to_string(&plain).unwrap();
+    let mut gapped = String::new();
+    for (k, line) in text.lines().enumerate() {
+        match line.split_once(',') {
+            // File line k + 1; from line 1502 on the stamps are 100 s later.
+            Some((t, rest)) if k + 1 >= 1502 => {
+                gapped += &format!("{},{rest}\n", t.parse::<f64>().unwrap() + 100.0);
+            }
+            _ => gapped += &format!("{line}\n"),
+        }
+    }
+    let gap = dir.join("gap.csv");
+    std::fs::write(&gap, gapped).unwrap();
+    let fit = |f: &Path| {
+        let (code, out, err) = hil_sim(&["fit", f.to_str().unwrap(), "--model", "algebraic", "--json"]);
+        assert_eq!(code, 0, "{err}");
+        serde_json::from_str::<serde_json::Value>(&out).unwrap()
+    };
+    let (a, b) = (fit(&plain), fit(&gap));
+    let dt = a["dt_s"].as_f64().unwrap();
+    assert!((b["dt_s"].as_f64().unwrap() - dt).abs() < 1e-3 * dt, "dt {} vs {dt}", b["dt_s"]);
+    let kinds: Vec<&str> = b["warnings"].as_array().unwrap().iter().filter_map(|w| w["kind"].as_str()).collect();
+    assert!(kinds.contains(&"dropout") && !kinds.contains(&"standstill"), "{}", b["warnings"]);
+    let (da, db) = (a["results"][0]["delay_s"].as_f64().unwrap(), b["results"][0]["delay_s"].as_f64().unwrap());
+    assert!((da - db).abs() <= 1.5 * dt, "delays {da} s vs {db} s");
+    let (_, out, _) = hil_sim(&["fit", gap.to_str().unwrap(), "--model", "algebraic"]);
+    assert!(out.contains("2 runs") && out.contains("gap in its time column") && out.contains("3000.0 Hz"), "{out}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

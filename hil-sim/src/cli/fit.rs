@@ -169,8 +169,15 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
         ));
     } else {
         let validate = data.runs.iter().any(|r| r.role == hil_sim::io::manifest::Role::Validate);
+        // Runs of one file are the stretches between gaps of its time column.
+        let gaps = data.runs.windows(2).filter(|w| w[0].file == w[1].file).count();
+        let split = match gaps {
+            0 => String::new(),
+            1 => " (one of them split at a gap in its time column)".to_owned(),
+            k => format!(" (split at {k} gaps in the time columns)"),
+        };
         super::emit(&format!(
-            "{}: {} runs, {} samples at {:.1} Hz; the model restarts at each run; {}\n\n",
+            "{}: {} runs{split}, {} samples at {:.1} Hz (gaps left out of the rate); the model restarts at each run; {}\n\n",
             label,
             data.runs.len(),
             data.len(),

@@ -83,25 +83,19 @@ impl Dataset {
         if let Some(v) = input.first().filter(|v| input.iter().all(|x| x == *v)) {
             return Err(DatasetError::ConstantInput { channel: ch.input.clone(), value: *v });
         }
-        let dt = rec.mean_dt(&ch.time)?;
+        let dt = rec.sample_interval(&ch.time)?;
         let n = input.len();
         let train_end = ((n as f64) * train).round() as usize;
         if train_end >= n {
             return Err(DatasetError::NoHeldOut);
         }
         let excluded = excluded.filter(|e| e.len() == n).unwrap_or_else(|| vec![false; n]);
-        let d = Self {
-            dt,
-            time,
-            input,
-            output,
-            command,
-            train_end,
-            excluded,
-            unusable: Vec::new(),
-            rates: None,
-            runs: Vec::new(),
-        };
+        let runs = gap_runs(&rec.path, &time, dt, train);
+        let d = Self { dt, time, input, output, command, train_end, excluded, unusable: Vec::new(), rates: None, runs };
+        let mut d = d;
+        if let Some(last) = d.runs.last() {
+            d.train_end = last.train_end;
+        }
         let usable = d.train_rows().len();
         if usable < 20 {
             return Err(DatasetError::TooFewSamples(usable));
@@ -224,6 +218,32 @@ impl Dataset {
             fs: 1.0 / self.dt,
         }
     }
+}
+
+/// A recording with gaps in its time column as runs: one per stretch between gaps, each
+/// split at `train` as a dataset's runs are, so that the model, its rate estimate and the
+/// delays restart after a gap as they do at the start of a recording (a fixed-step model
+/// cannot step across missing time). No gap: no runs (one recording, split at `train`).
+fn gap_runs(path: &Path, time: &[f64], dt: f64, train: f64) -> Vec<RunSpan> {
+    let gaps = crate::io::recording::gaps(time, dt);
+    if gaps.is_empty() {
+        return Vec::new();
+    }
+    let ends = gaps.iter().map(|i| i + 1).chain(std::iter::once(time.len()));
+    let mut start = 0;
+    let mut runs = Vec::with_capacity(gaps.len() + 1);
+    for end in ends {
+        let train_end = start + ((end - start) as f64 * train).round() as usize;
+        runs.push(RunSpan {
+            file: path.to_path_buf(),
+            role: crate::io::manifest::Role::Train,
+            start,
+            train_end: train_end.clamp(start, end),
+            end,
+        });
+        start = end;
+    }
+    runs
 }
 
 impl DatasetError {

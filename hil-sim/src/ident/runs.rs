@@ -239,13 +239,16 @@ fn join(runs: &[Prepared], roles: &[Role], any_validate: bool) -> Dataset {
         }
         d.excluded.extend_from_slice(&data.excluded);
         d.unusable.extend(data.unusable.iter().map(|i| i + start));
-        let end = d.len();
-        let train_end = match (any_validate, role) {
-            (false, _) => start + data.train_end,
-            (true, Role::Train) => end,
-            (true, Role::Validate) => start,
-        };
-        d.runs.push(RunSpan { file: r.recording.path.clone(), role: *role, start, train_end, end });
+        // A recording split at gaps in its time (`Dataset::runs`) stays split.
+        for span in data.spans() {
+            let (s, end) = (start + span.start, start + span.end);
+            let train_end = match (any_validate, role) {
+                (false, _) => start + span.train_end,
+                (true, Role::Train) => end,
+                (true, Role::Validate) => s,
+            };
+            d.runs.push(RunSpan { file: r.recording.path.clone(), role: *role, start: s, train_end, end });
+        }
     }
     // The one split a plot can mark: where the held-out runs begin, or the last run's split.
     d.train_end = d

@@ -63,16 +63,24 @@ pub fn replay_recording(
     let y = rec.channel(&ch.output)?;
     let u = ch.command.as_deref().map(|c| rec.channel(c)).transpose()?;
     crate::quality::timing::check_time_unit(&ch.time, t)?;
-    let dt = rec.mean_dt(&ch.time)?;
+    let dt = rec.sample_interval(&ch.time)?;
     let (d, d_u) = (delays_s.0 / dt, if u.is_some() { delays_s.1 / dt } else { 0.0 });
     crate::models::alignment::check(x.len(), dt, &[d, d_u])?;
     let (x, u) = crate::models::alignment::shift_channels(x, u, d, d_u);
     let samples = samples(&x, u.as_deref());
-    let out = replay(model, params, dt as f32, rate, &samples)?;
+    // A gap in the time column restarts the core, as a new run does (a fixed-step model
+    // cannot step across missing time), and no rate is taken across it.
+    let starts: Vec<usize> =
+        std::iter::once(0).chain(crate::io::recording::gaps(t, dt).into_iter().map(|i| i + 1)).collect();
+    let out = replay_runs(model, params, dt as f32, rate, &samples, &starts)?;
     let model_output: Vec<f64> = out.y.iter().map(|v| f64::from(*v)).collect();
-    // Rates for seed 001's E_x, E_ẋ: central differences of the input.
-    let dx = crate::numerics::derivative::gradient(&x, dt);
-    let ddx = crate::numerics::derivative::gradient(&dx, dt);
+    // Rates for seed 001's E_x, E_ẋ: central differences of the input, within each stretch.
+    let per_stretch = |v: &[f64]| -> Vec<f64> {
+        let ends = starts.iter().skip(1).copied().chain([v.len()]);
+        starts.iter().zip(ends).flat_map(|(&a, b)| crate::numerics::derivative::gradient(&v[a..b], dt)).collect()
+    };
+    let dx = per_stretch(&x);
+    let ddx = per_stretch(&dx);
     // Samples whose shifted channels read past the recording's ends are not scored.
     let (lo, hi) = crate::models::alignment::covered(x.len(), &[d, d_u]);
     let part = |v: &[f64]| v.get(lo..hi).unwrap_or(&[]).to_vec();

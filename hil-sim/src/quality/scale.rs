@@ -1,18 +1,11 @@
 //! A channel's own scales, measured on the recording: span, noise σ and half-period T½
 //! (see the module doc of [`quality`](super)); and the nominal sampling interval.
 
-use crate::numerics::stats::{mean, median, min_max};
+use crate::numerics::stats::{median, min_max};
 
-/// Mean of the intervals within 0.5–1.5× the median interval, s.
+/// Mean of the intervals within 0.5–1.5× the median interval, s (the recording's own).
 pub(super) fn nominal_dt(t: &[f64]) -> f64 {
-    let dts: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
-    let med = median(&dts);
-    let ok: Vec<f64> = dts.iter().copied().filter(|d| (0.5 * med..=1.5 * med).contains(d)).collect();
-    if ok.is_empty() {
-        med
-    } else {
-        mean(&ok)
-    }
+    crate::io::recording::nominal_interval(t)
 }
 
 /// A channel's own scales (see the module doc).

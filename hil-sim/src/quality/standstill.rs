@@ -14,7 +14,7 @@ pub(super) fn standstill(ctx: &Ctx, name: &str, v: &[f64], s: &Scale, cfg: &Qual
     }
     let band = cfg.standstill_band * s.span;
     let min_s = cfg.standstill_min_s.max(cfg.standstill_half_periods * s.half_period);
-    runs(still(ctx.t, v, band, min_s))
+    runs(still(ctx.dt, v, band, min_s))
         .into_iter()
         .map(|(a, b)| {
             let (lo, hi) = min_max(&v[a..=b]);
@@ -24,8 +24,6 @@ pub(super) fn standstill(ctx: &Ctx, name: &str, v: &[f64], s: &Scale, cfg: &Qual
         .collect()
 }
 
-/// Samples belonging to some window of at least `min_s` in which `v` stays within `band`
-/// (two pointers with monotone deques: O(n)).
 /// "it stays within LO to HI UNIT (P % of its span)": the band a channel `name` keeps to.
 fn stays_within(name: &str, lo: f64, hi: f64, span: f64) -> String {
     format!(
@@ -37,7 +35,10 @@ fn stays_within(name: &str, lo: f64, hi: f64, span: f64) -> String {
     )
 }
 
-fn still(t: &[f64], v: &[f64], band: f64, min_s: f64) -> Vec<bool> {
+/// Samples belonging to some window of at least `min_s` of recorded time (samples × the
+/// nominal interval `dt`: a gap in the stamps is missing data, not a rest) in which `v`
+/// stays within `band` (two pointers with monotone deques: O(n)).
+fn still(dt: f64, v: &[f64], band: f64, min_s: f64) -> Vec<bool> {
     use std::collections::VecDeque;
     let n = v.len();
     let mut mask = vec![false; n];
@@ -65,7 +66,7 @@ fn still(t: &[f64], v: &[f64], band: f64, min_s: f64) -> Vec<bool> {
                 lo.pop_front();
             }
         }
-        if t[j] - t[left] >= min_s {
+        if (j - left) as f64 * dt >= min_s {
             for m in mask.iter_mut().take(j + 1).skip(left.max(marked_to)) {
                 *m = true;
             }

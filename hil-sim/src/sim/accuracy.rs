@@ -231,7 +231,7 @@ pub fn synthetic(case: &Case, exc: &Excitation, fs: f64, duration: f64) -> Resul
 pub fn dyke(case: &Case, rec: &Recording) -> Result<Row, AccuracyError> {
     let x = rec.channel("D")?;
     let u = rec.channel("Y")?;
-    let dt = rec.mean_dt("t")?;
+    let dt = rec.sample_interval("t")?;
     let n = x.len();
     let samples: Vec<Sample> = x.iter().zip(u).map(|(x, u)| Sample::new(*x as f32).with_command(*u as f32)).collect();
     let core = replay(case.model, &case.params, dt as f32, RateSpec::Backward, &samples)?;

@@ -288,14 +288,46 @@ impl Recording {
         Ok(t)
     }
 
-    /// Mean sampling interval of the time column, seconds.
-    pub fn mean_dt(&self, time: &str) -> Result<f64, RecordingError> {
+    /// The sampling interval of the time column, seconds: the mean of the intervals within
+    /// 0.5–1.5 times the median one ([`nominal_interval`]), so that a gap (or a doubled
+    /// stamp) never enters the rate the models step at.
+    pub fn sample_interval(&self, time: &str) -> Result<f64, RecordingError> {
         let t = self.time(time)?;
-        match (t.first(), t.last()) {
-            (Some(a), Some(b)) if t.len() > 1 => Ok((b - a) / (t.len() - 1) as f64),
-            _ => Err(RecordingError::TooShort { path: self.path.clone(), rows: t.len() }),
+        if t.len() < 2 {
+            return Err(RecordingError::TooShort { path: self.path.clone(), rows: t.len() });
         }
+        Ok(nominal_interval(t))
     }
+}
+
+/// An interval of this many nominal intervals or more is a gap: samples are missing there.
+pub const GAP_INTERVALS: f64 = 1.5;
+
+/// The nominal sampling interval of increasing stamps `t`: the mean of the intervals within
+/// 0.5–1.5 times the median interval, i.e. the span less the intervals outside that band,
+/// over their number (exactly `(last − first) / (n − 1)` when none is outside). 0 for fewer
+/// than two stamps.
+pub fn nominal_interval(t: &[f64]) -> f64 {
+    let dts: Vec<f64> = t.windows(2).map(|w| w[1] - w[0]).collect();
+    let med = crate::numerics::stats::median(&dts);
+    let (mut out_sum, mut out_n) = (0.0, 0usize);
+    for d in dts.iter().filter(|d| !(0.5 * med..=1.5 * med).contains(*d)) {
+        out_sum += d;
+        out_n += 1;
+    }
+    match (t.first(), t.last()) {
+        (Some(a), Some(b)) if dts.len() > out_n => (b - a - out_sum) / (dts.len() - out_n) as f64,
+        _ => med,
+    }
+}
+
+/// The intervals of `t` that are gaps at nominal interval `dt` ([`GAP_INTERVALS`]): `i` for
+/// a gap between samples `i` and `i + 1`.
+pub fn gaps(t: &[f64], dt: f64) -> Vec<usize> {
+    if dt <= 0.0 {
+        return Vec::new();
+    }
+    t.windows(2).enumerate().filter(|(_, w)| (w[1] - w[0]) / dt >= GAP_INTERVALS).map(|(i, _)| i).collect()
 }
 
 #[cfg(test)]

@@ -24,7 +24,7 @@ fn reads_dyke_quirks() {
     assert_eq!(r.names(), vec!["t", "D", "F"]);
     assert_eq!(r.constants, vec![("fs".to_owned(), 3004.8)]);
     assert_eq!(r.channel("F").unwrap(), &[10.0, 11.0, 12.0]);
-    assert!((r.mean_dt("t").unwrap() - 0.1).abs() < 1e-12);
+    assert!((r.sample_interval("t").unwrap() - 0.1).abs() < 1e-12);
 }
 
 #[test]
@@ -60,7 +60,7 @@ fn reads_the_real_dyke_file() {
     assert_eq!(r.names(), vec!["t", "A", "D", "Y", "V", "F"]);
     assert!(r.time("t").is_ok());
     let fs = r.constants.iter().find(|(n, _)| n == "fs").map(|c| c.1).unwrap();
-    assert!((1.0 / r.mean_dt("t").unwrap() - fs).abs() < 1.0);
+    assert!((1.0 / r.sample_interval("t").unwrap() - fs).abs() < 1.0);
 }
 
 fn corpus(name: &str) -> PathBuf {
@@ -76,7 +76,7 @@ fn reads_mat_files_plain_and_compressed() {
     assert_eq!(a.constants, vec![("fs".to_owned(), 1000.0)]);
     assert_eq!(a.len(), 50);
     assert_eq!(a.columns, b.columns);
-    assert!((a.mean_dt("t").unwrap() - 0.001).abs() < 1e-12);
+    assert!((a.sample_interval("t").unwrap() - 0.001).abs() < 1e-12);
     assert_eq!(a.channel("temperature").unwrap()[3], 23.0);
     assert!((a.channel("speed").unwrap()[49] - 10.0).abs() < 1e-6);
     let ch = Channels::default();

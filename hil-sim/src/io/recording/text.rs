@@ -89,7 +89,13 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Recording, RecordingErr
             // Until a row has been read as numbers the file is not known to be a recording
             // (a manifest or a flag may name any file): nothing of it is quoted.
             let v = text.parse::<f64>().map_err(|_| match lines.is_empty() {
-                true => RecordingError::NotARecording { path: p(), line, field: i + 1, hint: hint.clone() },
+                // The separator a field seems to hold is said; the field itself is not.
+                true => RecordingError::NotARecording {
+                    path: p(),
+                    line,
+                    field: i + 1,
+                    hint: not_a_number_hint(text, dialect, &hint),
+                },
                 false => RecordingError::NotANumber {
                     path: p(),
                     line,
