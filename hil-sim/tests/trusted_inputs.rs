@@ -212,3 +212,70 @@ fn a_gap_in_the_time_column_splits_the_recording_and_leaves_the_rate_alone() {
     assert!(out.contains("2 runs") && out.contains("gap in its time column") && out.contains("3000.0 Hz"), "{out}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 61, behaviour 5: two saves into one folder mixed two fits, and an interrupted save
+/// left new and old model files side by side. A save is now one generation, swapped in
+/// whole; a second writer is refused while the first holds the folder; a folder of the
+/// user's own files is never replaced.
+#[test]
+fn a_saved_folder_is_one_generation() {
+    let dir = scratch("generation");
+    simulate(&dir.join("a.csv"), 1);
+    let save = dir.join("saved");
+    let fit = |models: &str| {
+        hil_sim(&[
+            "fit",
+            dir.join("a.csv").to_str().unwrap(),
+            "--model",
+            models,
+            "--delay",
+            "off",
+            "--save",
+            save.to_str().unwrap(),
+        ])
+    };
+    let (code, _, err) = fit("algebraic,dahl");
+    assert_eq!(code, 0, "{err}");
+    assert!(save.join("dahl.json").exists() && save.join("algebraic.json").exists());
+    // A leftover of an interrupted save beside it: removed, never swapped in.
+    let stale = dir.join(".saved.new-999999");
+    std::fs::create_dir_all(&stale).unwrap();
+    std::fs::write(stale.join("bouc_wen.json"), "{").unwrap();
+    let (code, _, err) = fit("algebraic");
+    assert_eq!(code, 0, "{err}");
+    let mut names: Vec<String> =
+        std::fs::read_dir(&save).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+    names.sort();
+    assert_eq!(names, [".hil-sim-generation", "algebraic.json", "fit-results.json"], "a mixed folder");
+    assert!(!stale.exists(), "the interrupted save's folder is still there");
+    // While another writer holds the folder, a save is refused and changes nothing.
+    #[cfg(unix)]
+    {
+        use std::os::unix::io::AsRawFd;
+        let lock = std::fs::File::open(dir.join(".saved.lock")).unwrap();
+        // SAFETY: flock on a descriptor this test owns.
+        assert_eq!(unsafe { libc::flock(lock.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) }, 0);
+        let before = std::fs::read(save.join("algebraic.json")).unwrap();
+        let (code, _, err) = fit("dahl");
+        assert_ne!(code, 0, "a second writer was let in");
+        assert!(err.contains("another hil-sim is writing"), "{err}");
+        assert_eq!(std::fs::read(save.join("algebraic.json")).unwrap(), before);
+        assert!(!save.join("dahl.json").exists());
+    }
+    // A folder of the user's own files is not replaced.
+    let mine = dir.join("mine");
+    std::fs::create_dir_all(&mine).unwrap();
+    std::fs::write(mine.join("notes.txt"), "keep me").unwrap();
+    let (code, _, err) = hil_sim(&[
+        "fit",
+        dir.join("a.csv").to_str().unwrap(),
+        "--model",
+        "algebraic",
+        "--save",
+        mine.to_str().unwrap(),
+    ]);
+    assert_ne!(code, 0);
+    assert!(err.contains("did not write") && err.contains("notes.txt"), "{err}");
+    assert_eq!(std::fs::read_to_string(mine.join("notes.txt")).unwrap(), "keep me");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -112,5 +112,7 @@ pub fn write_with(
     Ok(())
 }
 
+pub mod generation;
+
 #[cfg(test)]
 mod tests;

@@ -10,6 +10,7 @@ use thiserror::Error;
 use super::{fit, FitError, FitOptions, FitResult};
 use crate::ident::dataset::{DatasetError, Prepared};
 use crate::ident::runs::{prepare_runs, RunSpec, RunsError};
+use crate::io::output::generation::Generation;
 use crate::io::params_file::{FittedChannels, ParamsFile};
 use crate::progress::Progress;
 
@@ -65,6 +66,8 @@ pub enum FitJobError {
     Fit { model: String, source: Box<FitError> },
     #[error("{}: {reason}", path.display())]
     Save { path: PathBuf, reason: String },
+    #[error(transparent)]
+    Generation(#[from] crate::io::output::generation::GenerationError),
 }
 
 /// Fit each model in `ids` on `data`, one progress step per model; results in the order of `ids`.
@@ -159,11 +162,14 @@ pub fn save(
     channels: &FittedChannels,
 ) -> Result<Vec<PathBuf>, FitJobError> {
     let err = |path: &Path, reason: String| FitJobError::Save { path: path.to_owned(), reason };
-    crate::io::output::create_dir(dir).map_err(|e| err(dir, e.to_string()))?;
-    let mut written = Vec::with_capacity(results.len());
+    // One generation: every file of this save, swapped in together, or none of them.
+    let generation = Generation::begin(dir)?;
+    let stage = generation.path().to_path_buf();
+    let mut written = Vec::with_capacity(results.len() + 1);
     let source = format!("hil-sim fit {}", source_label(recordings));
     for r in results {
-        let file = dir.join(format!("{}.json", r.model));
+        let name = format!("{}.json", r.model);
+        let file = stage.join(&name);
         let flat: Vec<f32> = r.flat.iter().map(|v| *v as f32).collect();
         let mut pf = ParamsFile::from_flat(&r.model, Some(source.clone()), &flat)
             .ok_or_else(|| err(&file, "cannot build the parameter file".into()))?;
@@ -176,8 +182,8 @@ pub fn save(
         if text.len() as u64 > crate::io::params_file::MAX_BYTES {
             return Err(err(&file, format!("{} bytes, over the parameter file limit", text.len())));
         }
-        crate::io::output::write(&file, text).map_err(|e| err(&file, e.to_string()))?;
-        written.push(file);
+        crate::io::output::write(&file, text).map_err(|e| err(&dir.join(&name), e.to_string()))?;
+        written.push(dir.join(name));
     }
     // The scores, per model and per run, beside the sets: as large as the dataset is, so
     // never inside a parameter file.
@@ -185,8 +191,9 @@ pub fn save(
     let text = serde_json::to_string_pretty(&serde_json::json!({ "source": source, "results": results }))
         .map_err(|e| err(&file, e.to_string()))?
         + "\n";
-    crate::io::output::write(&file, text).map_err(|e| err(&file, e.to_string()))?;
+    crate::io::output::write(&stage.join(RESULTS_FILE), text).map_err(|e| err(&file, e.to_string()))?;
     written.push(file);
+    generation.commit(&source)?;
     Ok(written)
 }
 
