@@ -279,3 +279,30 @@ fn a_saved_folder_is_one_generation() {
     assert_eq!(std::fs::read_to_string(mine.join("notes.txt")).unwrap(), "keep me");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 61, behaviour 5 for reports: a report folder held the new page beside plots of an
+/// older one. `fit --out` and `diagnose --out` now write one generation each.
+#[test]
+fn a_report_folder_is_one_generation() {
+    let dir = scratch("report-generation");
+    simulate(&dir.join("a.csv"), 1);
+    let out = dir.join("report");
+    for cmd in ["fit", "diagnose", "fit"] {
+        let (code, _, err) = hil_sim(&[
+            cmd,
+            dir.join("a.csv").to_str().unwrap(),
+            "--model",
+            "algebraic",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert_eq!(code, 0, "{cmd}: {err}");
+        assert!(out.join("index.html").exists() && out.join(".hil-sim-generation").exists(), "{cmd}");
+        let what = std::fs::read_to_string(out.join(".hil-sim-generation")).unwrap();
+        assert!(what.contains(&format!("hil-sim {cmd} --out")), "{what}");
+        // A file of the previous generation never survives into the next.
+        assert!(!out.join("planted.svg").exists(), "{cmd}: an old file beside the new page");
+        std::fs::write(out.join("planted.svg"), "<svg/>").unwrap();
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -125,15 +125,18 @@ pub fn run(a: DiagnoseArgs) -> anyhow::Result<()> {
     let runs = a.recs.runs(&a.ch.channels())?;
     let (d, _) = run_diagnosis_runs(&runs, a.ch.keep_flagged, &opts)?;
     if let Some(dir) = &a.out {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        // One generation: the page and its plots swapped in together.
+        let generation = hil_sim::io::output::generation::Generation::begin(dir)?;
+        let stage = generation.path().to_path_buf();
         let label = match a.recs.recs.as_slice() {
             [one] if a.recs.dataset.is_none() => hil_sim::report::file_label(one),
             _ => a.recs.label(),
         };
         let mut rep = hil_sim::report::Report::new(format!("Diagnosis of {label}"));
-        hil_sim::report::diagnose::section(&mut rep, dir, "diagnose", &d, (&a.ch.input, &a.ch.output))?;
-        let index = rep.write(dir)?;
-        eprintln!("report written to {}", index.display());
+        hil_sim::report::diagnose::section(&mut rep, &stage, "diagnose", &d, (&a.ch.input, &a.ch.output))?;
+        rep.write(&stage)?;
+        generation.commit("hil-sim diagnose --out")?;
+        eprintln!("report written to {}", dir.join("index.html").display());
     }
     if a.json {
         return super::print_json(&serde_json::to_value(&d)?);

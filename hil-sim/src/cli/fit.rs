@@ -135,8 +135,11 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
             .chain(q.notes.iter().cloned())
             .map(|m| paths.iter().fold(m, |m, p| hil_sim::report::relabel(&m, p)))
             .collect();
-        let index = fit_page::write(dir, &title, data, &run.results, &labels, &warnings)?;
-        eprintln!("report written to {}", index.display());
+        // One generation: the page and its plots swapped in together.
+        let generation = hil_sim::io::output::generation::Generation::begin(dir)?;
+        fit_page::write(generation.path(), &title, data, &run.results, &labels, &warnings)?;
+        generation.commit("hil-sim fit --out")?;
+        eprintln!("report written to {}", dir.join("index.html").display());
     }
     let best = run.best().map(|r| r.model.clone());
     // Samples in training parts (all of a dataset's runs; `train_end` for one recording).
