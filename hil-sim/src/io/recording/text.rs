@@ -116,21 +116,25 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<Recording, RecordingErr
         return Err(RecordingError::HeaderOnly { path: p() });
     }
     // The header is judged once rows of numbers show the file is a recording.
-    let mut seen = std::collections::HashSet::with_capacity(names.len());
-    for n in &names {
-        if !n.is_empty() && !seen.insert(n.as_str()) {
-            return Err(RecordingError::Malformed {
-                path: p(),
-                line: header_line,
-                reason: format!("column `{}` appears twice in the header", shown(n)),
-            });
-        }
-    }
+    no_repeated_name(path, &names, header_line)?;
     let (columns, constants) = columns(path, names, raw, &lines)?;
     if rows < 3 {
         return Err(RecordingError::TooShort { path: p(), rows });
     }
     Ok(Recording { path: p(), columns, constants, lines, format: Format::Csv, skipped: Vec::new() })
+}
+
+/// A header naming no column twice.
+fn no_repeated_name(path: &Path, names: &[String], line: u64) -> Result<(), RecordingError> {
+    let mut seen = std::collections::HashSet::with_capacity(names.len());
+    match names.iter().find(|n| !n.is_empty() && !seen.insert(n.as_str())) {
+        Some(n) => Err(RecordingError::Malformed {
+            path: path.to_path_buf(),
+            line,
+            reason: format!("column `{}` appears twice in the header", shown(n)),
+        }),
+        None => Ok(()),
+    }
 }
 
 /// The parsed fields as channels and constants (a column filled on its first row only); an
