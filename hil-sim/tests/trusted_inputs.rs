@@ -9,25 +9,7 @@ use common::{hil_sim, scratch};
 
 /// A simulated recording (2 s at 500 Hz, noise excitation) with random seed `seed`.
 fn simulate(path: &Path, seed: u64) {
-    let seed = seed.to_string();
-    let (code, _, err) = hil_sim(&[
-        "simulate",
-        "--effect",
-        "field_lag",
-        "--base",
-        "algebraic",
-        "--excitation",
-        "noise",
-        "--seed",
-        &seed,
-        "--duration",
-        "2",
-        "--fs",
-        "500",
-        "--out",
-        path.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    common::simulate_noise_with(path, seed, 2.0, 500.0);
 }
 
 /// A manifest in `dir` with a train and a validate run.
@@ -167,22 +149,7 @@ fn what_fit_saves_replay_reads_whatever_the_number_of_runs() {
 fn a_gap_in_the_time_column_splits_the_recording_and_leaves_the_rate_alone() {
     let dir = scratch("gap");
     let plain = dir.join("plain.csv");
-    let (code, _, err) = hil_sim(&[
-        "simulate",
-        "--effect",
-        "field_lag",
-        "--base",
-        "algebraic",
-        "--excitation",
-        "noise",
-        "--duration",
-        "2",
-        "--fs",
-        "3000",
-        "--out",
-        plain.to_str().unwrap(),
-    ]);
-    assert_eq!(code, 0, "{err}");
+    common::simulate_noise_with(&plain, 1, 2.0, 3000.0);
     let text = std::fs::read_to_string(&plain).unwrap();
     let mut gapped = String::new();
     for (k, line) in text.lines().enumerate() {

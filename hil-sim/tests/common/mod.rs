@@ -47,6 +47,12 @@ pub fn scratch(name: &str) -> PathBuf {
 /// A short simulated clutch recording at `path` (4 s at 500 Hz, algebraic truth, band-limited
 /// noise, a concealed field lag).
 pub fn simulate_noise(path: &Path) {
+    simulate_noise_with(path, 1, 4.0, 500.0);
+}
+
+/// [`simulate_noise`] with its random seed, duration (s) and sampling rate (Hz).
+pub fn simulate_noise_with(path: &Path, seed: u64, duration_s: f64, fs: f64) {
+    let (seed, duration, fs) = (seed.to_string(), duration_s.to_string(), fs.to_string());
     let (code, _, err) = hil_sim(&[
         "simulate",
         "--effect",
@@ -55,10 +61,12 @@ pub fn simulate_noise(path: &Path) {
         "algebraic",
         "--excitation",
         "noise",
+        "--seed",
+        &seed,
         "--duration",
-        "4",
+        &duration,
         "--fs",
-        "500",
+        &fs,
         "--out",
         path.to_str().unwrap(),
     ]);
