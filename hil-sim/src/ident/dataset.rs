@@ -91,8 +91,8 @@ impl Dataset {
         }
         let excluded = excluded.filter(|e| e.len() == n).unwrap_or_else(|| vec![false; n]);
         let runs = gap_runs(&rec.path, &time, dt, train);
-        let d = Self { dt, time, input, output, command, train_end, excluded, unusable: Vec::new(), rates: None, runs };
-        let mut d = d;
+        let mut d =
+            Self { dt, time, input, output, command, train_end, excluded, unusable: Vec::new(), rates: None, runs };
         if let Some(last) = d.runs.last() {
             d.train_end = last.train_end;
         }
