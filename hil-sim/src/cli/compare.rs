@@ -3,7 +3,7 @@ use std::path::PathBuf;
 use anyhow::bail;
 use clap::Args;
 use hil_sim::ident::compare::{compare, Named};
-use hil_sim::ident::dataset::prepare;
+use hil_sim::ident::dataset::{prepare, Keeping};
 use hil_sim::ident::fit::FitOptions;
 use hil_sim::ident::runs::{from_manifest, RunSpec};
 use hil_sim::io::manifest::Role;
@@ -42,7 +42,7 @@ pub struct CompareArgs {
 
 fn load(path: &std::path::Path, ch: &Channels, a: &CompareArgs, train: f64) -> anyhow::Result<Named> {
     let p = super::file_arg(path)?;
-    let prepared = prepare(&p, ch, train, a.ch.keep_flagged)?;
+    let prepared = prepare(&p, ch, train, a.ch.keep_flagged, Keeping::DatasetOnly)?;
     for w in &prepared.quality.warnings {
         eprintln!("warning: {}", w.message);
     }

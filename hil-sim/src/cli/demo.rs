@@ -3,7 +3,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::Args;
 use hil_sim::closed_loop::{compare as loop_compare, identify, multisine_reference, Run, T_START};
-use hil_sim::ident::dataset::{prepare, Dataset, Prepared};
+use hil_sim::ident::dataset::{prepare, Dataset, Keeping, Prepared};
 use hil_sim::ident::diagnose::Diagnosis;
 use hil_sim::ident::fit::{FitOptions, FitResult};
 use hil_sim::io::params_file::ParamsFile;
@@ -47,7 +47,8 @@ fn dyke_channels() -> Channels {
 
 fn fit_dyke(file: &'static str) -> anyhow::Result<DykeFit> {
     let path = hil_sim::io::bundled::data_file(file).map_err(anyhow::Error::msg)?;
-    let Prepared { recording: rec, quality: q, data } = prepare(&path, &dyke_channels(), TRAIN, false)?;
+    let Prepared { recording: rec, quality: q, data } =
+        prepare(&path, &dyke_channels(), TRAIN, false, Keeping::Everything)?;
     let warnings: Vec<String> = q.warnings.iter().map(|w| w.message.clone()).collect();
     for w in &warnings {
         eprintln!("warning: {w}");
@@ -149,7 +150,7 @@ fn published_spencer(rep: &mut Report, fits: &[DykeFit]) -> anyhow::Result<Vec<s
     let mut rows = Vec::new();
     let mut replays = Vec::new();
     for f in fits {
-        let r = replay_recording(&f.rec, &dyke_channels(), &pf.model, &flat, RateSpec::Backward, (0.0, 0.0))?;
+        let r = replay_recording(f.rec.clone(), &dyke_channels(), &pf.model, &flat, RateSpec::Backward, (0.0, 0.0))?;
         let m = r.metrics;
         rows.push(vec![
             f.file.to_owned(),

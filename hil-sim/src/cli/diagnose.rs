@@ -2,7 +2,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
-use hil_sim::ident::dataset::{Dataset, Prepared};
+use hil_sim::ident::dataset::{Dataset, Keeping, Prepared};
 use hil_sim::ident::diagnose::{diagnose, leak, DiagnoseError, DiagnoseOptions, Diagnosis};
 use hil_sim::ident::runs::{prepare_runs, RunSpec, RunsError};
 use hil_sim::io::recording::Channels;
@@ -65,10 +65,11 @@ pub fn run_diagnosis_runs(
     opts.check().map_err(flagged)?;
     let Some(first) = runs.first() else { anyhow::bail!("no recording given") };
     let (path, ch) = (&first.path, &first.channels);
-    let prepared = prepare_runs(runs, 1.0 - opts.heldout, keep_flagged).map_err(|e| match e {
+    let prepared = prepare_runs(runs, 1.0 - opts.heldout, keep_flagged, Keeping::Everything).map_err(|e| match e {
         RunsError::Dataset(d) => anyhow::Error::from(d),
         e => e.into(),
     })?;
+    let aux = joined_auxiliary(prepared.each(), runs);
     let Prepared { quality: q, data, .. } = prepared.joined;
     for w in &q.warnings {
         eprintln!("warning: {}", w.message);
@@ -76,7 +77,6 @@ pub fn run_diagnosis_runs(
     for n in &q.notes {
         eprintln!("warning: {n}");
     }
-    let aux = joined_auxiliary(&prepared.runs, runs);
     let (aux, dropped) = leak::screen(aux, &data.output, ch.command.as_deref());
     for d in &dropped {
         eprintln!("warning: {}: channel `{}` is not used by the diagnosis: {}", path.display(), d.name, d.reason);

@@ -103,7 +103,7 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
     })?;
     bar.finish();
     let (label, data, q) = (a.recs.label(), &run.prepared.data, &run.prepared.quality);
-    for r in &run.runs {
+    for r in run.each() {
         super::list_skipped(a.ch.verbose, &r.recording);
     }
     for w in &q.warnings {
@@ -127,7 +127,7 @@ pub fn run(a: FitArgs) -> anyhow::Result<()> {
         };
         let labels = Labels::for_channels(&a.ch.input, &a.ch.output);
         // Messages name files without the user's folders.
-        let paths: Vec<&std::path::Path> = run.runs.iter().map(|r| r.recording.path.as_path()).collect();
+        let paths: Vec<&std::path::Path> = run.each().iter().map(|r| r.recording.path.as_path()).collect();
         let warnings: Vec<String> = q
             .warnings
             .iter()

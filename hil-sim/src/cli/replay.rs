@@ -3,7 +3,7 @@ use std::path::PathBuf;
 use anyhow::{bail, Context};
 use clap::Args;
 use hil_sim::io::params_file::ParamsFile;
-use hil_sim::io::recording::{Channels, Recording};
+use hil_sim::io::recording::{Channels, Keep, Recording};
 use hil_sim::models::replay::{pooled, replay_recording, ReplayReport};
 use hil_sim::quality;
 use serde_json::json;
@@ -82,8 +82,9 @@ fn one(
         eprintln!("warning: {w}");
     }
     let delays = (pf.delay_s.unwrap_or(0.0), pf.command_delay_s.unwrap_or(0.0));
-    let r = replay_recording(&rec, ch, &pf.model, flat, rate, delays)
-        .with_context(|| format!("replaying {}", rec.path.display()))?;
+    let path = rec.path.clone();
+    let r = replay_recording(rec, ch, &pf.model, flat, rate, delays)
+        .with_context(|| format!("replaying {}", path.display()))?;
     Ok((r, q))
 }
 
@@ -105,7 +106,7 @@ pub fn run(a: ReplayArgs) -> anyhow::Result<()> {
     let mut reports = Vec::with_capacity(specs.len());
     let mut qualities = Vec::with_capacity(specs.len());
     for s in &specs {
-        let rec = Recording::read(&s.path)?;
+        let rec = Recording::read_keeping(&s.path, &Keep::roles(&s.channels))?;
         let (r, q) = one(rec, &s.channels, &pf, &flat, &a, rate)?;
         reports.push(r);
         qualities.push(q);

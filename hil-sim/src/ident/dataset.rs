@@ -8,10 +8,10 @@ use model_core::Sample;
 use thiserror::Error;
 
 use crate::io::recording::Channels;
-use crate::io::recording::{Recording, RecordingError};
+use crate::io::recording::{Keep, Recording, RecordingError};
 use crate::models::search::Scales;
 use crate::numerics::derivative::gradient;
-use crate::numerics::stats::mean_std;
+use crate::numerics::stats::mean_std_at;
 use crate::quality::{self, Quality};
 
 /// Why a dataset could not be built.
@@ -200,18 +200,17 @@ impl Dataset {
     /// Spreads of the training part (see [`Scales`]).
     pub fn scales(&self) -> Scales {
         let rows = self.train_rows();
-        let pick = |v: &[f64]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
-        let x = pick(&self.input);
         let dx = self.per_run(&self.input, |v| gradient(v, self.dt));
         let ddx = self.per_run(&dx, |v| gradient(v, self.dt));
-        let (x_mean, xs) = mean_std(&x);
-        let (y_mean, ys) = mean_std(&pick(&self.output));
-        let u = self.command.as_ref().map(|u| pick(u).iter().fold(0.0f64, |a, b| a.max(b.abs())));
+        let (x_mean, xs) = mean_std_at(&rows, &self.input);
+        let (y_mean, ys) = mean_std_at(&rows, &self.output);
+        let u =
+            self.command.as_ref().map(|u| rows.iter().filter_map(|&i| u.get(i)).fold(0.0f64, |a, b| a.max(b.abs())));
         Scales {
             x_mean,
             x: xs,
-            dx: mean_std(&pick(&dx)).1,
-            ddx: mean_std(&pick(&ddx)).1,
+            dx: mean_std_at(&rows, &dx).1,
+            ddx: mean_std_at(&rows, &ddx).1,
             y_mean,
             y: ys,
             u: u.filter(|u| *u > 0.0),
@@ -266,10 +265,35 @@ pub struct Prepared {
     pub data: Dataset,
 }
 
+/// What a preparation keeps of the recording besides the dataset.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Keeping {
+    /// Every channel (a diagnosis looks at the auxiliary ones as possible causes).
+    Everything,
+    /// The dataset only: the channels no role names are not kept when the file is read, and
+    /// those the dataset copied are released from the recording, which keeps its path, line
+    /// map, constants and notes (a fit reads nothing else, and a long recording is held once).
+    DatasetOnly,
+}
+
 /// Read `path`, run the data-quality checks on the channels `ch` and split at `train`;
 /// flagged samples are left out of fitting unless `keep_flagged`.
-pub fn prepare(path: &Path, ch: &Channels, train: f64, keep_flagged: bool) -> Result<Prepared, DatasetError> {
-    prepare_recording(Recording::read(path)?, ch, train, keep_flagged)
+pub fn prepare(
+    path: &Path,
+    ch: &Channels,
+    train: f64,
+    keep_flagged: bool,
+    keeping: Keeping,
+) -> Result<Prepared, DatasetError> {
+    let keep = match keeping {
+        Keeping::Everything => Keep::All,
+        Keeping::DatasetOnly => Keep::roles(ch),
+    };
+    let mut prepared = prepare_recording(Recording::read_keeping(path, &keep)?, ch, train, keep_flagged)?;
+    if keeping == Keeping::DatasetOnly {
+        prepared.recording.release(&ch.roles());
+    }
+    Ok(prepared)
 }
 
 /// [`prepare`] for a recording already in memory (a generated one, or a file read before).

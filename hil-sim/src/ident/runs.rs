@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
-use crate::ident::dataset::{prepare, Dataset, DatasetError, Prepared, RunSpan};
+use crate::ident::dataset::{prepare, Dataset, DatasetError, Keeping, Prepared, RunSpan};
 use crate::io::manifest::{Manifest, ManifestError, Role, RunPaths};
 use crate::io::recording::Channels;
 use crate::quality::Quality;
@@ -75,15 +75,32 @@ pub struct PreparedRuns {
     /// The joined dataset ([`Dataset::runs`] holds the boundaries); its quality is every run's,
     /// with sample indices into the joined data; its recording is the first run's.
     pub joined: Prepared,
+    /// Each run's own preparation; empty for a single recording, which is `joined` itself
+    /// (held once: a long recording is not kept twice). [`PreparedRuns::each`] gives both cases.
     pub runs: Vec<Prepared>,
+}
+
+impl PreparedRuns {
+    /// Each run's preparation (the one recording's for a single run).
+    pub fn each(&self) -> &[Prepared] {
+        match self.runs.as_slice() {
+            [] => std::slice::from_ref(&self.joined),
+            runs => runs,
+        }
+    }
 }
 
 /// Read, check and split every run, and join them. A single run is prepared exactly as
 /// [`prepare`] does (no run table).
-pub fn prepare_runs(specs: &[RunSpec], train: f64, keep_flagged: bool) -> Result<PreparedRuns, RunsError> {
+pub fn prepare_runs(
+    specs: &[RunSpec],
+    train: f64,
+    keep_flagged: bool,
+    keeping: Keeping,
+) -> Result<PreparedRuns, RunsError> {
     let mut runs = Vec::with_capacity(specs.len());
     for s in specs {
-        runs.push((prepare(&s.path, &s.channels, train, keep_flagged)?, s.role));
+        runs.push((prepare(&s.path, &s.channels, train, keep_flagged, keeping)?, s.role));
     }
     join_prepared(runs)
 }
@@ -91,9 +108,11 @@ pub fn prepare_runs(specs: &[RunSpec], train: f64, keep_flagged: bool) -> Result
 /// Join runs already prepared (e.g. from [`crate::ident::dataset::prepare_recording`]), each
 /// with its role.
 pub fn join_prepared(runs: Vec<(Prepared, Role)>) -> Result<PreparedRuns, RunsError> {
-    let (runs, roles): (Vec<Prepared>, Vec<Role>) = runs.into_iter().unzip();
-    if let [one] = runs.as_slice() {
-        return Ok(PreparedRuns { joined: one.clone(), runs });
+    let (mut runs, roles): (Vec<Prepared>, Vec<Role>) = runs.into_iter().unzip();
+    if runs.len() == 1 {
+        if let Some(joined) = runs.pop() {
+            return Ok(PreparedRuns { joined, runs });
+        }
     }
     let first = runs.first().ok_or(DatasetError::NoHeldOut)?;
     let path = |r: &Prepared| r.recording.path.clone();

@@ -48,9 +48,11 @@ pub fn pooled(reports: &[ReplayReport]) -> Result<Metrics, NoSamples> {
 }
 
 /// Replay `rec` through `model` with flat `params`, the input and the command read
-/// `delays_s` later ([`crate::models::alignment`]; 0 for none).
+/// `delays_s` later ([`crate::models::alignment`]; 0 for none). The recording is consumed:
+/// its time and output channels move into the report, and the samples the core sees are made
+/// one at a time, so a long recording is held once.
 pub fn replay_recording(
-    rec: &Recording,
+    mut rec: Recording,
     ch: &Channels,
     model: &str,
     params: &[f32],
@@ -58,44 +60,66 @@ pub fn replay_recording(
     delays_s: (f64, f64),
 ) -> Result<ReplayReport, ReplayError> {
     rec.check_roles(ch)?;
-    let t = rec.time(&ch.time)?;
-    let x = rec.channel(&ch.input)?;
-    let y = rec.channel(&ch.output)?;
-    let u = ch.command.as_deref().map(|c| rec.channel(c)).transpose()?;
-    crate::quality::timing::check_time_unit(&ch.time, t)?;
+    crate::quality::timing::check_time_unit(&ch.time, rec.time(&ch.time)?)?;
     let dt = rec.sample_interval(&ch.time)?;
+    let time = rec.take_channel(&ch.time)?;
+    let measured = rec.take_channel(&ch.output)?;
+    let (x, u) = (rec.channel(&ch.input)?, ch.command.as_deref().map(|c| rec.channel(c)).transpose()?);
     let (d, d_u) = (delays_s.0 / dt, if u.is_some() { delays_s.1 / dt } else { 0.0 });
     crate::models::alignment::check(x.len(), dt, &[d, d_u])?;
-    let (x, u) = crate::models::alignment::shift_channels(x, u, d, d_u);
-    let samples = samples(&x, u.as_deref());
+    let shifted = (d != 0.0 || d_u != 0.0).then(|| crate::models::alignment::shift_channels(x, u, d, d_u));
+    let (x, u) = match &shifted {
+        Some((x, u)) => (x.as_slice(), u.as_deref()),
+        None => (x, u),
+    };
     // A gap in the time column restarts the core, as a new run does (a fixed-step model
     // cannot step across missing time), and no rate is taken across it.
     let starts: Vec<usize> =
-        std::iter::once(0).chain(crate::io::recording::gaps(t, dt).into_iter().map(|i| i + 1)).collect();
-    let out = replay_runs(model, params, dt as f32, rate, &samples, &starts)?;
+        std::iter::once(0).chain(crate::io::recording::gaps(&time, dt).into_iter().map(|i| i + 1)).collect();
+    let out = replay_channels(model, params, dt as f32, rate, (x, u), &starts)?;
     let model_output: Vec<f64> = out.y.iter().map(|v| f64::from(*v)).collect();
+    drop(out.y);
     // Rates for seed 001's E_x, E_ẋ: central differences of the input, within each stretch.
     let per_stretch = |v: &[f64]| -> Vec<f64> {
+        if let [_] = starts.as_slice() {
+            return crate::numerics::derivative::gradient(v, dt);
+        }
         let ends = starts.iter().skip(1).copied().chain([v.len()]);
         starts.iter().zip(ends).flat_map(|(&a, b)| crate::numerics::derivative::gradient(&v[a..b], dt)).collect()
     };
-    let dx = per_stretch(&x);
+    let dx = per_stretch(x);
     let ddx = per_stretch(&dx);
     // Samples whose shifted channels read past the recording's ends are not scored.
     let (lo, hi) = crate::models::alignment::covered(x.len(), &[d, d_u]);
-    let part = |v: &[f64]| v.get(lo..hi).unwrap_or(&[]).to_vec();
+    fn part(v: &[f64], (lo, hi): (usize, usize)) -> &[f64] {
+        v.get(lo..hi).unwrap_or(&[])
+    }
+    let metrics = try_metrics(
+        part(&measured, (lo, hi)),
+        part(&model_output, (lo, hi)),
+        Some((part(&dx, (lo, hi)), part(&ddx, (lo, hi)))),
+    )?;
     Ok(ReplayReport {
         model: model.to_owned(),
         samples: x.len(),
         dt_s: dt,
-        metrics: try_metrics(&part(y), &part(&model_output), Some((&part(&dx), &part(&ddx))))?,
+        metrics,
         held: out.held,
-        time: t.to_vec(),
-        measured: y.to_vec(),
+        time,
+        measured,
         model_output,
         rates: (dx, ddx),
         scored: (lo, hi),
     })
+}
+
+/// The sample the core sees at `i`: input `x` in f32, with the command `u` when there is one.
+fn sample_at(x: &[f64], u: Option<&[f64]>, i: usize) -> Sample {
+    let s = Sample::new(x.get(i).map_or(f32::NAN, |v| *v as f32));
+    match u.and_then(|u| u.get(i)) {
+        Some(uv) => s.with_command(*uv as f32),
+        None => s,
+    }
 }
 
 /// The samples the core sees: input `x` in f32, with the command `u` when there is one.
@@ -113,16 +137,7 @@ pub fn samples_with_rates(x: &[f64], u: Option<&[f64]>, rates: Option<&(Vec<f64>
 }
 
 pub fn samples(x: &[f64], u: Option<&[f64]>) -> Vec<Sample> {
-    x.iter()
-        .enumerate()
-        .map(|(i, xv)| {
-            let s = Sample::new(*xv as f32);
-            match u.and_then(|u| u.get(i)) {
-                Some(uv) => s.with_command(*uv as f32),
-                None => s,
-            }
-        })
-        .collect()
+    (0..x.len()).map(|i| sample_at(x, u, i)).collect()
 }
 
 /// Why a replay could not start.
@@ -150,35 +165,50 @@ pub struct Replay {
     pub held: usize,
 }
 
-struct Run<'a> {
+/// A replay to run: the model's parameters and step, and where its samples come from (a
+/// slice of [`Sample`]s, or channels made into samples one at a time).
+struct Run<'a, F> {
     params: &'a [f32],
     dt: f32,
     rate: RateSpec,
-    samples: &'a [Sample],
+    /// The stretches' starts, `0` first: the core restarts at each.
+    starts: &'a [usize],
+    len: usize,
+    sample: F,
 }
 
-impl Visit for Run<'_> {
+impl<F: Fn(usize) -> Sample> Visit for Run<'_, F> {
     type Out = Result<Replay, ParamError>;
     fn visit<M: Model>(self) -> Self::Out {
         let model = M::from_params(self.params, self.dt)?;
         let est = Estimator::new(model, self.rate.build(self.dt)?)?;
-        let mut st = est.state();
-        let mut out = Replay { y: Vec::with_capacity(self.samples.len()), held: 0 };
-        for s in self.samples {
-            let o = est.step(&mut st, *s);
-            out.held += usize::from(!o.flags.ok());
-            out.y.push(o.y);
+        let mut out = Replay { y: Vec::with_capacity(self.len), held: 0 };
+        let bounds = self.starts.iter().copied().filter(|&s| s > 0 && s < self.len).chain([self.len]);
+        let mut a = 0;
+        for b in bounds {
+            let mut st = est.state();
+            for i in a..b {
+                let o = est.step(&mut st, (self.sample)(i));
+                out.held += usize::from(!o.flags.ok());
+                out.y.push(o.y);
+            }
+            a = b;
         }
         Ok(out)
     }
 }
 
+/// Run `run` through model `id`.
+fn dispatch<F: Fn(usize) -> Sample>(id: &str, run: Run<'_, F>) -> Result<Replay, ReplayError> {
+    visit(id, run)
+        .ok_or_else(|| ReplayError::UnknownModel(id.to_owned()))?
+        .map_err(|source| ReplayError::Params { model: id.to_owned(), source })
+}
+
 /// Run `samples` through model `id` with flat parameters `params`, one step per sample
 /// of `dt` seconds, in f32 — the code the firmware runs.
 pub fn replay(id: &str, params: &[f32], dt: f32, rate: RateSpec, samples: &[Sample]) -> Result<Replay, ReplayError> {
-    visit(id, Run { params, dt, rate, samples })
-        .ok_or_else(|| ReplayError::UnknownModel(id.to_owned()))?
-        .map_err(|source| ReplayError::Params { model: id.to_owned(), source })
+    replay_runs(id, params, dt, rate, samples, &[0])
 }
 
 /// [`replay`] of a dataset whose runs start at `starts`: the core (state and rate
@@ -191,16 +221,34 @@ pub fn replay_runs(
     samples: &[Sample],
     starts: &[usize],
 ) -> Result<Replay, ReplayError> {
-    let n = samples.len();
-    let mut out = Replay { y: Vec::with_capacity(n), held: 0 };
-    let mut a = 0;
-    for b in starts.iter().copied().filter(|&s| s > 0 && s < n).chain([n]) {
-        let r = replay(id, params, dt, rate, samples.get(a..b).unwrap_or(&[]))?;
-        out.y.extend(r.y);
-        out.held += r.held;
-        a = b;
-    }
-    Ok(out)
+    let sample = |i: usize| samples.get(i).copied().unwrap_or(Sample::new(f32::NAN));
+    dispatch(id, Run { params, dt, rate, starts, len: samples.len(), sample })
+}
+
+/// [`replay_runs`] of `len` samples made by `sample` as the core steps (nothing held but
+/// the output).
+pub fn replay_made(
+    id: &str,
+    params: &[f32],
+    dt: f32,
+    rate: RateSpec,
+    (len, sample): (usize, impl Fn(usize) -> Sample),
+    starts: &[usize],
+) -> Result<Replay, ReplayError> {
+    dispatch(id, Run { params, dt, rate, starts, len, sample })
+}
+
+/// [`replay_runs`] of input `x` and command `u` made into samples as the core steps
+/// ([`samples`] without holding them).
+pub fn replay_channels(
+    id: &str,
+    params: &[f32],
+    dt: f32,
+    rate: RateSpec,
+    (x, u): (&[f64], Option<&[f64]>),
+    starts: &[usize],
+) -> Result<Replay, ReplayError> {
+    replay_made(id, params, dt, rate, (x.len(), |i| sample_at(x, u, i)), starts)
 }
 
 #[cfg(test)]

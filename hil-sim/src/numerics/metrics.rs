@@ -36,32 +36,54 @@ fn sq(v: f64) -> f64 {
 /// derivative at each sample, for seed 001's E_x and E_ẋ.
 pub fn metrics(measured: &[f64], model: &[f64], rates: Option<(&[f64], &[f64])>) -> Metrics {
     let n = measured.len().min(model.len());
+    let pair = |k: usize| (measured[k], model[k]);
+    let weights =
+        rates.filter(|(dx, ddx)| dx.len() >= n && ddx.len() >= n).map(|(dx, ddx)| move |k: usize| (dx[k], ddx[k]));
+    summed(n, pair, weights, rates.is_some())
+}
+
+/// [`metrics`] of the samples `rows` (indices into every slice), without copying them out:
+/// the same sums in the same order, so the same figures as [`metrics`] of the picked samples.
+pub fn metrics_at(rows: &[usize], measured: &[f64], model: &[f64], rates: Option<(&[f64], &[f64])>) -> Metrics {
+    let at = |v: &[f64], k: usize| rows.get(k).and_then(|&i| v.get(i)).copied().unwrap_or(f64::NAN);
+    let pair = |k: usize| (at(measured, k), at(model, k));
+    let weights = rates.map(|(dx, ddx)| move |k: usize| (at(dx, k), at(ddx, k)));
+    summed(rows.len(), pair, weights, rates.is_some())
+}
+
+/// The metrics of `n` pairs (measured, model) given by `pair`, with the input's rate and
+/// acceleration by `weights` when known; `rated`: a rate was given (E_t is reported).
+fn summed(
+    n: usize,
+    pair: impl Fn(usize) -> (f64, f64),
+    weights: Option<impl Fn(usize) -> (f64, f64)>,
+    rated: bool,
+) -> Metrics {
     if n == 0 {
         return Metrics::default();
     }
-    let (y, m) = (&measured[..n], &model[..n]);
-    let mean = super::stats::mean(y);
-    let sse: f64 = y.iter().zip(m).map(|(a, b)| sq(a - b)).sum();
-    let sst: f64 = y.iter().map(|a| sq(a - mean)).sum();
-    let ssy: f64 = y.iter().map(|a| sq(*a)).sum();
+    let mean = (0..n).map(|k| pair(k).0).sum::<f64>() / n as f64;
+    let sse: f64 = (0..n).map(|k| pair(k)).map(|(a, b)| sq(a - b)).sum();
+    let sst: f64 = (0..n).map(|k| sq(pair(k).0 - mean)).sum();
+    let ssy: f64 = (0..n).map(|k| sq(pair(k).0)).sum();
     let ratio = |num: f64, den: f64| if den > 0.0 { num / den } else { f64::NAN };
     let (mut md, mut ad, mut nd) = (0.0, 0.0, 0usize);
-    for (a, b) in y.iter().zip(m) {
-        if *a != 0.0 {
+    for (a, b) in (0..n).map(&pair) {
+        if a != 0.0 {
             let d = (a - b) / a;
             md += d.abs();
             ad += d;
             nd += 1;
         }
     }
-    let weighted = |w: &[f64]| {
-        let num: f64 = y.iter().zip(m).zip(w).map(|((a, b), w)| sq(a - b) * w.abs()).sum();
-        let den: f64 = y.iter().zip(w).map(|(a, w)| sq(a - mean) * w.abs()).sum();
+    let weighted = |w: &dyn Fn(usize) -> f64| {
+        let num: f64 = (0..n).map(|k| (pair(k), w(k))).map(|((a, b), w)| sq(a - b) * w.abs()).sum();
+        let den: f64 = (0..n).map(|k| sq(pair(k).0 - mean) * w(k).abs()).sum();
         ratio(num, den).sqrt()
     };
-    let (e_x, e_xdot) = match rates {
-        Some((dx, ddx)) if dx.len() >= n && ddx.len() >= n => (Some(weighted(&dx[..n])), Some(weighted(&ddx[..n]))),
-        _ => (None, None),
+    let (e_x, e_xdot) = match &weights {
+        Some(w) => (Some(weighted(&|k| w(k).0)), Some(weighted(&|k| w(k).1))),
+        None => (None, None),
     };
     let nrmse = ratio(sse, sst).sqrt();
     Metrics {
@@ -70,7 +92,7 @@ pub fn metrics(measured: &[f64], model: &[f64], rates: Option<(&[f64], &[f64])>)
         r_rmse: ratio(sse, ssy).sqrt(),
         r2: 1.0 - ratio(sse, sst),
         gof: 1.0 - nrmse,
-        e_t: rates.map(|_| nrmse),
+        e_t: rated.then_some(nrmse),
         e_x,
         e_xdot,
         mean_dev: if nd > 0 { md / nd as f64 } else { 0.0 },
@@ -99,6 +121,19 @@ pub fn r_rmse(reference: &[f64], a: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn metrics_of_rows_are_those_of_the_picked_samples() {
+        let y: Vec<f64> = (0..50).map(|i| (i as f64 * 0.3).sin() + 0.1).collect();
+        let m: Vec<f64> = y.iter().enumerate().map(|(i, v)| v + 0.01 * (i % 7) as f64 - 0.02).collect();
+        let dx: Vec<f64> = (0..50).map(|i| (i as f64 * 0.3).cos()).collect();
+        let rows: Vec<usize> = (3..47).filter(|i| i % 3 != 0).collect();
+        let pick = |v: &[f64]| -> Vec<f64> { rows.iter().map(|&i| v[i]).collect() };
+        let want = metrics(&pick(&y), &pick(&m), Some((&pick(&dx), &pick(&y))));
+        assert_eq!(metrics_at(&rows, &y, &m, Some((&dx, &y))), want);
+        assert_eq!(metrics_at(&rows, &y, &m, None), metrics(&pick(&y), &pick(&m), None));
+        assert!(want.e_x.is_some() && want.n == rows.len());
+    }
 
     #[test]
     fn perfect_and_known_errors() {

@@ -10,6 +10,15 @@ pub fn mean(v: &[f64]) -> f64 {
     v.iter().sum::<f64>() / v.len().max(1) as f64
 }
 
+/// [`mean_std`] of the samples `rows` of `v` (indices past its end are left out), without
+/// copying them: the same sums in the same order.
+pub fn mean_std_at(rows: &[usize], v: &[f64]) -> (f64, f64) {
+    let picked = || rows.iter().filter_map(|&i| v.get(i));
+    let n = picked().count().max(1) as f64;
+    let m = picked().sum::<f64>() / n;
+    (m, (picked().map(|a| (a - m) * (a - m)).sum::<f64>() / n).sqrt())
+}
+
 /// Mean m and population standard deviation √(Σ(v − m)² / n); (0, 0) for an empty slice.
 pub fn mean_std(v: &[f64]) -> (f64, f64) {
     let n = v.len().max(1) as f64;

@@ -52,7 +52,7 @@ pub(super) struct Ctx<'a> {
 
 impl Ctx<'_> {
     pub(super) fn warning(&self, kind: WarningKind, channel: &str, first: usize, last: usize, what: String) -> Warning {
-        let line = |i: usize| self.rec.lines.get(i).copied().unwrap_or(i as u64 + 1);
+        let line = |i: usize| self.rec.lines.get(i).unwrap_or(i as u64 + 1);
         let (start_s, end_s) = (self.t[first], self.t[last]);
         Warning {
             kind,

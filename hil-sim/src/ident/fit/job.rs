@@ -8,7 +8,7 @@ use std::sync::Mutex;
 use thiserror::Error;
 
 use super::{fit, FitError, FitOptions, FitResult};
-use crate::ident::dataset::{DatasetError, Prepared};
+use crate::ident::dataset::{DatasetError, Keeping, Prepared};
 use crate::ident::runs::{prepare_runs, RunSpec, RunsError};
 use crate::io::output::generation::Generation;
 use crate::io::params_file::{FittedChannels, ParamsFile};
@@ -35,7 +35,8 @@ pub struct FitJob {
 pub struct FitRun {
     /// The data fitted (a dataset's runs joined, [`crate::ident::dataset::Dataset::runs`]).
     pub prepared: Prepared,
-    /// Each recording's own preparation (one for a single recording).
+    /// Each recording's own preparation when there are several (empty for a single
+    /// recording, which is `prepared`); [`FitRun::each`] gives both cases.
     pub runs: Vec<Prepared>,
     /// One per model, in the job's order.
     pub results: Vec<FitResult>,
@@ -46,6 +47,14 @@ pub struct FitRun {
 }
 
 impl FitRun {
+    /// Each recording's preparation (the one recording's for a single run).
+    pub fn each(&self) -> &[Prepared] {
+        match self.runs.as_slice() {
+            [] => std::slice::from_ref(&self.prepared),
+            runs => runs,
+        }
+    }
+
     /// The model with the lowest held-out RMSE.
     pub fn best(&self) -> Option<&FitResult> {
         self.results
@@ -136,7 +145,7 @@ fn expected_cost(
 
 /// Run the job: prepare the recording, fit, save.
 pub fn run(job: &FitJob, progress: &dyn Progress) -> Result<FitRun, FitJobError> {
-    let prepared = prepare_runs(&job.runs, job.train, job.keep_flagged).map_err(|e| match e {
+    let prepared = prepare_runs(&job.runs, job.train, job.keep_flagged, Keeping::DatasetOnly).map_err(|e| match e {
         RunsError::Dataset(d) => FitJobError::Dataset(d),
         e => FitJobError::Runs(e),
     })?;

@@ -43,11 +43,11 @@ use crate::io::params_file::{ParamsFile, Values};
 use crate::models::search::{ModelSpec, Scales, Strategy, Structure};
 use crate::models::RateSpec;
 use crate::numerics::derivative::gradient;
-use crate::numerics::metrics::{metrics, Metrics};
+use crate::numerics::metrics::{metrics_at, Metrics};
 use global::SwarmOptions;
 
 pub use crate::ident::dataset::{Dataset, DatasetError};
-use delays::{as_seen, scan_delay};
+use delays::scan_delay;
 use objective::Objective;
 use per_run::per_run_metrics;
 pub use per_run::RunMetrics;
@@ -215,9 +215,12 @@ pub fn fit(id: &str, data: &Dataset, opts: &FitOptions) -> Result<FitResult, Fit
     // The first search is not finished (scored, checked): its delays are discarded, its
     // parameters are where the refit starts (a second global search cost as much as the first).
     let held = DelayChoice::Fixed(if edge_x { 0.0 } else { d * dt }, if edge_u { 0.0 } else { d_u * dt });
-    let mut r = search(id, data, &FitOptions { delay: held, ..*opts }, Some((&first.params, first.variant)))?;
-    r.seconds += first.seconds;
-    r.evaluations += first.evaluations;
+    // Only the first search's parameters go on: its kinematics are released before the
+    // refit builds its own.
+    let Searched { params, variant, seconds, evaluations, .. } = first;
+    let mut r = search(id, data, &FitOptions { delay: held, ..*opts }, Some((&params, variant)))?;
+    r.seconds += seconds;
+    r.evaluations += evaluations;
     finish(id, data, opts, r, Some(identifiable::edge_warning(&which, dt)))
 }
 
@@ -226,7 +229,6 @@ struct Searched {
     sp: ModelSpec,
     scales: Scales,
     sim: Box<dyn simulate::Simulator>,
-    samples: Vec<model_core::Sample>,
     starts: Vec<usize>,
     kin: Vec<model_core::Kin>,
     rows: Vec<usize>,
@@ -252,9 +254,9 @@ fn search(id: &str, data: &Dataset, opts: &FitOptions, warm: Option<(&[f64], usi
     let sp = host.spec(&scales, opts.rate).ok_or_else(|| FitError::NotFittable(id.to_owned()))?;
     let started = Instant::now();
     let dt = data.dt as f32;
-    let samples = data.samples();
     let starts = data.run_starts();
-    let kin = simulate::kinematics_runs(&samples, dt, sp.rate, &starts)
+    let seen = delays::Seen::of(data, (0.0, 0.0), &starts);
+    let kin = simulate::kinematics_of((0..data.len()).map(|i| seen.sample(i)), dt, sp.rate, &starts)
         .ok_or(FitError::RateOverflow { model: id.to_owned() })?;
     let sim = simulate::simulator_runs(id, dt, &starts).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
     let rows = data.train_rows();
@@ -302,7 +304,6 @@ fn search(id: &str, data: &Dataset, opts: &FitOptions, warm: Option<(&[f64], usi
         sp,
         scales,
         sim,
-        samples,
         starts,
         kin,
         rows,
@@ -326,7 +327,7 @@ fn finish(
     first_warning: Option<String>,
 ) -> Result<FitResult, FitError> {
     let info = model_core::registry::find(id).ok_or_else(|| FitError::UnknownModel(id.to_owned()))?;
-    let Searched { sp, scales, sim, samples, starts, kin, rows, constant_u, mut params, mut evaluations, .. } = found;
+    let Searched { sp, scales, sim, starts, kin, rows, constant_u, mut params, mut evaluations, .. } = found;
     // The variant the search kept: its held values and box, not the model's spec's.
     let variant = found.variant;
     let sp = crate::models::host(id).and_then(|h| h.at_variant(&sp, variant, &scales)).unwrap_or(sp);
@@ -360,22 +361,22 @@ fn finish(
         warnings.extend(operator::abw_warning(&params, dt, &kin, ds, &starts, &rows));
     }
     warnings.extend(confidence_warning);
+    drop(kin);
     let fit_seconds = found.seconds + started.elapsed().as_secs_f64();
 
     // Score with the Estimator path, the firmware's code, over the whole recording.
     let p32: Vec<f32> = params.iter().map(|v| *v as f32).collect();
-    let (input, samples) = as_seen(data, samples, (delay, delay_u), &starts);
+    let seen = delays::Seen::of(data, (delay, delay_u), &starts);
     let t0 = Instant::now();
-    let rep = crate::models::replay::replay_runs(id, &p32, dt, sp.rate, &samples, &starts)
+    let rep = crate::models::replay::replay_made(id, &p32, dt, sp.rate, (data.len(), |i| seen.sample(i)), &starts)
         .map_err(|e| FitError::Replay { model: id.to_owned(), reason: e.to_string() })?;
-    let replay_ns = t0.elapsed().as_secs_f64() * 1e9 / samples.len().max(1) as f64;
+    let replay_ns = t0.elapsed().as_secs_f64() * 1e9 / data.len().max(1) as f64;
     let output: Vec<f64> = rep.y.iter().map(|v| f64::from(*v)).collect();
-    let dx = data.per_run(&input, |v| gradient(v, data.dt));
+    drop(rep.y);
+    let dx = data.per_run(&seen.input, |v| gradient(v, data.dt));
     let ddx = data.per_run(&dx, |v| gradient(v, data.dt));
-    let score = |rows: &[usize]| {
-        let pick = |v: &[f64]| -> Vec<f64> { rows.iter().filter_map(|&i| v.get(i).copied()).collect() };
-        metrics(&pick(&data.output), &pick(&output), Some((&pick(&dx), &pick(&ddx))))
-    };
+    drop(seen);
+    let score = |rows: &[usize]| metrics_at(rows, &data.output, &output, Some((&dx, &ddx)));
     // A delayed channel has no data for the first or last few samples of a run: those are not scored.
     let ds = [delay, delay_u];
     let unflagged = data.covered(&data.heldout_unflagged(), &ds);

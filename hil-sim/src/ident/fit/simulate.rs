@@ -107,12 +107,23 @@ pub fn kinematics(samples: &[Sample], dt: f32, rate: RateSpec) -> Option<Vec<Kin
 
 /// [`kinematics`] with the estimator restarted at every run start in `starts`.
 pub fn kinematics_runs(samples: &[Sample], dt: f32, rate: RateSpec, starts: &[usize]) -> Option<Vec<Kin>> {
+    kinematics_of(samples.iter().copied(), dt, rate, starts)
+}
+
+/// [`kinematics_runs`] of samples made as they are needed (a dataset's channels, without
+/// holding a sample per row).
+pub fn kinematics_of(
+    samples: impl Iterator<Item = Sample> + Clone,
+    dt: f32,
+    rate: RateSpec,
+    starts: &[usize],
+) -> Option<Vec<Kin>> {
     let params = rate.build(dt).ok()?;
     // Every sample carries both rates (the zero-phase ones): the estimator's would be unused.
-    let given = samples.iter().all(|s| s.dx.is_some() && s.ddx.is_some());
+    let given = samples.clone().all(|s| s.dx.is_some() && s.ddx.is_some());
     let mut st = RateState::default();
-    let mut out = Vec::with_capacity(samples.len());
-    for (i, s) in samples.iter().enumerate() {
+    let mut out = Vec::with_capacity(samples.size_hint().0);
+    for (i, s) in samples.enumerate() {
         if i > 0 && starts.contains(&i) {
             st = RateState::default();
         }

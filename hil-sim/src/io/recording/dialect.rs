@@ -1,7 +1,7 @@
 //! Text recordings as labs save them: the separator (comma, semicolon, tab or spaces) and
 //! the decimal mark (a decimal comma goes with a semicolon, tab or space separator) are
 //! found from the first line that has any, and the text is rewritten as plain CSV line
-//! for line (so file line numbers stay right, CRLF or not).
+//! for line as it is read (so file line numbers stay right, CRLF or not).
 
 /// How the fields of a text recording are separated.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -43,30 +43,37 @@ impl Dialect {
     }
 }
 
-/// `text` in `dialect` rewritten as CSV, one output line per input line; decimal commas
-/// become points (any comma inside a field, since commas do not separate in these dialects).
-pub fn to_csv(text: &str, dialect: Dialect) -> String {
-    let mut out = String::with_capacity(text.len());
-    for line in text.lines() {
-        let fields: Vec<&str> = match dialect {
-            Dialect::Comma => vec![line],
-            Dialect::Semicolon => line.split(';').collect(),
-            Dialect::Tab => line.split('\t').collect(),
-            Dialect::Space => line.split_whitespace().collect(),
-        };
-        for (i, f) in fields.iter().enumerate() {
-            if i > 0 {
-                out.push(',');
-            }
-            if dialect == Dialect::Comma {
-                out.push_str(f);
-            } else {
-                out.extend(f.trim().chars().map(|c| if c == ',' { '.' } else { c }));
-            }
+/// One line of a text recording in `dialect` (without or with its `\n` or `\r\n`) appended to
+/// `out` as a CSV line ending in `\n`; decimal commas become points (any comma inside a field,
+/// since commas do not separate in these dialects). A line that is not UTF-8 is passed on as
+/// it is, for the CSV reader to refuse with its line number.
+pub fn line_to_csv(line: &[u8], dialect: Dialect, out: &mut Vec<u8>) {
+    let line = line.strip_suffix(b"\n").unwrap_or(line);
+    let line = line.strip_suffix(b"\r").unwrap_or(line);
+    let text = match std::str::from_utf8(line) {
+        Ok(text) if dialect != Dialect::Comma => text,
+        _ => {
+            out.extend_from_slice(line);
+            out.push(b'\n');
+            return;
         }
-        out.push('\n');
+    };
+    match dialect {
+        Dialect::Semicolon => fields_to_csv(text.split(';'), out),
+        Dialect::Tab => fields_to_csv(text.split('\t'), out),
+        Dialect::Comma | Dialect::Space => fields_to_csv(text.split_whitespace(), out),
     }
-    out
+    out.push(b'\n');
+}
+
+/// Fields joined by commas, each trimmed, its decimal commas made points.
+fn fields_to_csv<'a>(fields: impl Iterator<Item = &'a str>, out: &mut Vec<u8>) {
+    for (i, f) in fields.enumerate() {
+        if i > 0 {
+            out.push(b',');
+        }
+        out.extend(f.trim().bytes().map(|c| if c == b',' { b'.' } else { c }));
+    }
 }
 
 #[cfg(test)]
@@ -79,7 +86,13 @@ mod tests {
         assert_eq!(Dialect::sniff("\n t\tb\n"), Dialect::Tab);
         assert_eq!(Dialect::sniff("t  b\n"), Dialect::Space);
         assert_eq!(Dialect::sniff("\"t\",\"b\",\n"), Dialect::Comma);
-        assert_eq!(to_csv("t;b\r\n0,5;1,25\r\n", Dialect::Semicolon), "t,b\n0.5,1.25\n");
-        assert_eq!(to_csv("  0.0  -1.4e-3\n", Dialect::Space), "0.0,-1.4e-3\n");
+        let csv = |text: &str, d| {
+            let mut out = Vec::new();
+            text.split_inclusive('\n').for_each(|l| line_to_csv(l.as_bytes(), d, &mut out));
+            String::from_utf8(out).unwrap()
+        };
+        assert_eq!(csv("t;b\r\n0,5;1,25\r\n", Dialect::Semicolon), "t,b\n0.5,1.25\n");
+        assert_eq!(csv("  0.0  -1.4e-3\n", Dialect::Space), "0.0,-1.4e-3\n");
+        assert_eq!(csv("t,b\r\n\"a\",1", Dialect::Comma), "t,b\n\"a\",1\n");
     }
 }

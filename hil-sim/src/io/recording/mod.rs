@@ -8,6 +8,8 @@
 
 pub mod dialect;
 mod dspace;
+mod lines;
+pub use lines::LineMap;
 mod mat;
 mod select;
 mod text;
@@ -94,12 +96,40 @@ pub struct Recording {
     pub constants: Vec<(String, f64)>,
     /// File line of each data row (1-based, header is line 1), for error messages;
     /// for a MAT-file the sample number (1-based).
-    pub lines: Vec<u64>,
+    pub lines: LineMap,
     /// CSV or MAT: whether `lines` are file lines or sample numbers.
     pub format: Format,
     /// Variables of the file that are not channels (a matrix, text, another length, NaN),
     /// with the reason; an error only when a command asks for one of them.
     pub skipped: Vec<Skipped>,
+    /// Channels of the file that were checked but not kept ([`Keep::Named`]), or released.
+    pub unread: Vec<String>,
+}
+
+/// Which channels a reader keeps in memory. Every column is read and checked either way
+/// (a value that is not a number is refused wherever it is); a constant is always kept.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Keep {
+    All,
+    /// Only these channels (a command that uses the roles' channels only: a 30-minute log
+    /// at 10 kHz is then held as its three or four channels, not all of them).
+    Named(Vec<String>),
+}
+
+impl Keep {
+    /// The channels `ch` names: its roles and the constants it gives.
+    pub fn roles(ch: &Channels) -> Self {
+        let mut names: Vec<String> = ch.roles().into_iter().map(str::to_owned).collect();
+        names.extend(ch.set.iter().map(|(n, _)| n.clone()));
+        Self::Named(names)
+    }
+
+    pub fn keeps(&self, name: &str) -> bool {
+        match self {
+            Self::All => true,
+            Self::Named(names) => names.iter().any(|n| n == name),
+        }
+    }
 }
 
 /// A variable of the file that is not a channel, and why.
@@ -128,9 +158,28 @@ impl Recording {
     /// Read a recording, CSV or MAT-file: a file starting with a MAT-file header, or
     /// named `*.mat`, is read as a MAT-file; anything else as CSV.
     pub fn read(path: &Path) -> Result<Self, RecordingError> {
+        Self::read_keeping(path, &Keep::All)
+    }
+
+    /// [`Recording::read`] keeping only the channels `keep` names in memory (a text file is
+    /// read as it streams; a MAT-file is read whole, then the others are dropped).
+    pub fn read_keeping(path: &Path, keep: &Keep) -> Result<Self, RecordingError> {
+        use std::io::Read;
         crate::io::output::note_input(path);
-        let bytes = std::fs::read(path).map_err(|source| RecordingError::Io { path: path.to_path_buf(), source })?;
-        Self::parse(path, &bytes)
+        let io = |source| RecordingError::Io { path: path.to_path_buf(), source };
+        let mut file = std::fs::File::open(path).map_err(io)?;
+        let mut head = Vec::new();
+        file.by_ref().take(8).read_to_end(&mut head).map_err(io)?;
+        let mat_ext = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("mat"));
+        if !(mat_ext || is_mat(&head)) {
+            return text::read(path, std::io::Cursor::new(head).chain(file), keep);
+        }
+        file.read_to_end(&mut head).map_err(io)?;
+        let mut rec = Self::parse_mat(path, &head)?;
+        let (kept, unread): (Vec<Column>, Vec<Column>) = rec.columns.into_iter().partition(|c| keep.keeps(&c.name));
+        rec.columns = kept;
+        rec.unread = unread.into_iter().map(|c| c.name).collect();
+        Ok(rec)
     }
 
     /// Parse CSV or MAT bytes (chosen as in [`Recording::read`]); `path` names the file
@@ -158,16 +207,17 @@ impl Recording {
             path: path.to_path_buf(),
             columns,
             constants,
-            lines: (1..=rows as u64).collect(),
+            lines: LineMap::numbered(rows),
             format: Format::Mat,
             skipped: Vec::new(),
+            unread: Vec::new(),
         }
     }
 
     /// Where samples `first..=last` (0-based) are, for messages: `rec.csv:12-40` (file
     /// lines) or `rec.mat: samples 11-39` (1-based sample numbers).
     pub fn place(&self, first: usize, last: usize) -> String {
-        let line = |i: usize| self.lines.get(i).copied().unwrap_or(i as u64 + 1);
+        let line = |i: usize| self.lines.get(i).unwrap_or(i as u64 + 1);
         let (a, b) = (line(first), line(last));
         let range = if a == b { a.to_string() } else { format!("{a}-{b}") };
         match self.format {
@@ -177,7 +227,7 @@ impl Recording {
         }
     }
 
-    /// Auxiliary channels: every numeric column other than the time, input and output
+    /// Keeping channels: every numeric column other than the time, input and output
     /// (the command channel, if any, is one of them).
     pub fn auxiliary(&self, ch: &Channels) -> Vec<&str> {
         self.columns
@@ -218,8 +268,9 @@ impl Recording {
     /// Read a CSV recording.
     pub fn read_csv(path: &Path) -> Result<Self, RecordingError> {
         crate::io::output::note_input(path);
-        let bytes = std::fs::read(path).map_err(|source| RecordingError::Io { path: path.to_path_buf(), source })?;
-        Self::parse_csv(path, &bytes)
+        let file =
+            std::fs::File::open(path).map_err(|source| RecordingError::Io { path: path.to_path_buf(), source })?;
+        text::read(path, file, &Keep::All)
     }
 
     /// Parse text bytes (CSV, or semicolon-, tab- or space-separated, see [`dialect`]);
@@ -251,11 +302,32 @@ impl Recording {
         if let Some(s) = self.skipped.iter().find(|s| s.name == name) {
             return Err(RecordingError::Unusable { path: self.path.clone(), detail: s.reason.clone() });
         }
+        if self.unread.iter().any(|n| n == name) {
+            let detail = format!("channel `{}` was not kept when the file was read", shown(name));
+            return Err(RecordingError::Unusable { path: self.path.clone(), detail });
+        }
         let mut available = self.names().iter().map(|n| shown(n)).collect::<Vec<_>>().join(", ");
         if self.format == Format::Csv && self.names().iter().enumerate().all(|(i, n)| *n == (i + 1).to_string()) {
             available += "; the file has no header row, so its columns are numbered from 1";
         }
         Err(RecordingError::MissingColumn { path: self.path.clone(), name: name.to_owned(), available })
+    }
+
+    /// Move channel `name` out of the recording (for a consumer that keeps it, so that a long
+    /// recording is not held twice); errors as [`Recording::channel`].
+    pub fn take_channel(&mut self, name: &str) -> Result<Vec<f64>, RecordingError> {
+        match self.columns.iter().position(|c| c.name == name) {
+            Some(i) => Ok(self.columns.remove(i).values),
+            None => self.channel(name).map(<[f64]>::to_vec),
+        }
+    }
+
+    /// Release channels `names` (a consumer holds copies): they are then [`Recording::unread`].
+    pub fn release(&mut self, names: &[&str]) {
+        let (gone, kept): (Vec<Column>, Vec<Column>) =
+            std::mem::take(&mut self.columns).into_iter().partition(|c| names.contains(&c.name.as_str()));
+        self.columns = kept;
+        self.unread.extend(gone.into_iter().map(|c| c.name));
     }
 
     /// The channels `ch` names, checked to be different columns (an output that is also
@@ -277,7 +349,7 @@ impl Recording {
         for (i, w) in t.windows(2).enumerate() {
             if let [a, b] = *w {
                 if b <= a {
-                    let (path, at) = (self.path.clone(), self.lines.get(i + 1).copied().unwrap_or(i as u64 + 2));
+                    let (path, at) = (self.path.clone(), self.lines.get(i + 1).unwrap_or(i as u64 + 2));
                     return Err(match self.format {
                         Format::Csv => RecordingError::TimeNotIncreasing { path, line: at, prev: a, t: b },
                         Format::Mat => RecordingError::SampleTimeNotIncreasing { path, sample: at, prev: a, t: b },

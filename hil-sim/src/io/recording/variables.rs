@@ -95,9 +95,10 @@ pub(super) fn recording(path: &Path, vars: Vec<Variable>) -> Result<Recording, R
         path: p(),
         columns: vectors,
         constants,
-        lines: (1..=rows as u64).collect(),
+        lines: super::LineMap::numbered(rows),
         format: Format::Mat,
         skipped,
+        unread: Vec::new(),
     })
 }
 
