@@ -76,7 +76,7 @@ pub fn replay_recording(
     // cannot step across missing time), and no rate is taken across it.
     let starts: Vec<usize> =
         std::iter::once(0).chain(crate::io::recording::gaps(&time, dt).into_iter().map(|i| i + 1)).collect();
-    let out = replay_channels(model, params, dt as f32, rate, (x, u), &starts)?;
+    let out = replay_made(model, params, dt as f32, rate, (x.len(), |i| sample_at(x, u, i)), &starts)?;
     let model_output: Vec<f64> = out.y.iter().map(|v| f64::from(*v)).collect();
     drop(out.y);
     // Rates for seed 001's E_x, E_ẋ: central differences of the input, within each stretch.
@@ -114,7 +114,7 @@ pub fn replay_recording(
 }
 
 /// The sample the core sees at `i`: input `x` in f32, with the command `u` when there is one.
-fn sample_at(x: &[f64], u: Option<&[f64]>, i: usize) -> Sample {
+pub fn sample_at(x: &[f64], u: Option<&[f64]>, i: usize) -> Sample {
     let s = Sample::new(x.get(i).map_or(f32::NAN, |v| *v as f32));
     match u.and_then(|u| u.get(i)) {
         Some(uv) => s.with_command(*uv as f32),
@@ -236,19 +236,6 @@ pub fn replay_made(
     starts: &[usize],
 ) -> Result<Replay, ReplayError> {
     dispatch(id, Run { params, dt, rate, starts, len, sample })
-}
-
-/// [`replay_runs`] of input `x` and command `u` made into samples as the core steps
-/// ([`samples`] without holding them).
-pub fn replay_channels(
-    id: &str,
-    params: &[f32],
-    dt: f32,
-    rate: RateSpec,
-    (x, u): (&[f64], Option<&[f64]>),
-    starts: &[usize],
-) -> Result<Replay, ReplayError> {
-    replay_made(id, params, dt, rate, (x.len(), |i| sample_at(x, u, i)), starts)
 }
 
 #[cfg(test)]

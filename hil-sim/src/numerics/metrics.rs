@@ -63,7 +63,7 @@ fn summed(
         return Metrics::default();
     }
     let mean = (0..n).map(|k| pair(k).0).sum::<f64>() / n as f64;
-    let sse: f64 = (0..n).map(|k| pair(k)).map(|(a, b)| sq(a - b)).sum();
+    let sse: f64 = (0..n).map(&pair).map(|(a, b)| sq(a - b)).sum();
     let sst: f64 = (0..n).map(|k| sq(pair(k).0 - mean)).sum();
     let ssy: f64 = (0..n).map(|k| sq(pair(k).0)).sum();
     let ratio = |num: f64, den: f64| if den > 0.0 { num / den } else { f64::NAN };

@@ -12,10 +12,13 @@ use super::Dataset;
 /// delays within each run, borrowed from the dataset where a delay is zero (a shift by zero
 /// is the channel itself), so the samples the core steps through are made one at a time.
 pub(super) struct Seen<'a> {
-    pub input: Cow<'a, [f64]>,
-    command: Option<Cow<'a, [f64]>>,
-    rates: Option<(Cow<'a, [f64]>, Cow<'a, [f64]>)>,
+    pub input: Channel<'a>,
+    command: Option<Channel<'a>>,
+    rates: Option<(Channel<'a>, Channel<'a>)>,
 }
+
+/// One channel of [`Seen`]: the dataset's own, or its shifted copy.
+type Channel<'a> = Cow<'a, [f64]>;
 
 impl<'a> Seen<'a> {
     pub fn of(data: &'a Dataset, (delay, delay_u): (f64, f64), starts: &[usize]) -> Self {
@@ -35,10 +38,7 @@ impl<'a> Seen<'a> {
 
     /// The sample at `i`, as [`crate::models::replay::samples_with_rates`] makes it.
     pub fn sample(&self, i: usize) -> Sample {
-        let mut s = Sample::new(self.input.get(i).map_or(f32::NAN, |v| *v as f32));
-        if let Some(u) = self.command.as_ref().and_then(|u| u.get(i)) {
-            s = s.with_command(*u as f32);
-        }
+        let mut s = crate::models::replay::sample_at(&self.input, self.command.as_deref(), i);
         if let Some((dx, ddx)) = &self.rates {
             s.dx = dx.get(i).map(|v| *v as f32);
             s.ddx = ddx.get(i).map(|v| *v as f32);
